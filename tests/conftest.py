@@ -1,0 +1,27 @@
+"""Shared fixtures: the repository root and small scenarios computed once per session."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+PAPER_CASE = ROOT / "models" / "paper_case.toml"
+
+os.environ.setdefault("MPLBACKEND", "Agg")
+
+
+@pytest.fixture(scope="session")
+def root() -> Path:
+    return ROOT
+
+
+@pytest.fixture(scope="session")
+def paper_run():
+    """The paper case at its default 50 × 50 × 30 m cells."""
+    from uamopt.scenario import load_scenario
+    from uamopt.stages import compute_risk
+
+    return compute_risk(load_scenario(PAPER_CASE))

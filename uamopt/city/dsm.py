@@ -1,0 +1,197 @@
+"""City layers from a digital surface model (DSM) GeoTIFF, through rasterio.
+
+The DSM must be in a projected CRS in metres (UTM, a national grid). The local frame's (0, 0) is
+the raster's (left, bottom) corner, x east, y north (MODEL_NOTES). Each grid column takes the
+maximum DSM value over its footprint (conservative: the column is an obstacle up to its highest
+point), then
+
+- ground datum = ``city.ground_m``, or the raster minimum (nodata ignored);
+- surface_height = max(DSM − ground, 0); building_height = surface_height where it exceeds
+  ``city.building_min_height_m`` (trees and cars below it count as ground), else 0;
+- c_s from the Table B.3 height rule, unless ``city.shelter`` gives a c_s GeoTIFF (averaged).
+
+Optional GeoJSON road centre lines (``city.roads``) and no-fly polygons (``city.no_fly``) are in
+the raster's CRS. Population density is uniform (``city.population_density``).
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+import rasterio
+import shapely
+import shapely.geometry
+from affine import Affine
+from rasterio.warp import Resampling, reproject
+
+from uamopt.city.layers import CityLayers, burn_mask, line_segments, segment_length_per_cell, shelter_rule
+from uamopt.errors import InputFileError, ScenarioError
+
+if TYPE_CHECKING:
+    from uamopt.grid import AirspaceGrid
+    from uamopt.scenario import Scenario
+
+_KINDS = {"LineString": (1, 5), "Polygon": (3, 6)}  # shapely type ids of a kind and its Multi form
+
+
+def read_geojson(path: Path, where: str, kinds: tuple[str, ...]) -> list[shapely.Geometry]:
+    """Geometries of a GeoJSON file (FeatureCollection, Feature or bare geometry), split into parts.
+
+    Parameters
+    ----------
+    path : Path
+        The GeoJSON file; coordinates are taken as they are (no CRS conversion).
+    where : str
+        The scenario key that named the file, for error messages (``city.roads``).
+    kinds : tuple of str
+        Geometry kinds kept, ``"LineString"`` and/or ``"Polygon"`` (their Multi forms included).
+
+    Raises
+    ------
+    InputFileError
+        Missing or malformed file, or a file with geometries none of which is of ``kinds``.
+    """
+    if not path.is_file():
+        raise InputFileError(f"GeoJSON file not found: {path}", where, "give the path of a .geojson file")
+    try:
+        doc = json.loads(path.read_text(encoding="utf-8"))
+        if doc.get("type") == "FeatureCollection":
+            raw = [f.get("geometry") for f in doc["features"]]
+        elif doc.get("type") == "Feature":
+            raw = [doc.get("geometry")]
+        else:
+            raw = [doc]
+        geoms = np.asarray([shapely.geometry.shape(g) for g in raw if g], dtype=object)
+    except (OSError, UnicodeDecodeError, ValueError, KeyError, TypeError, AttributeError, shapely.errors.ShapelyError) as exc:
+        raise InputFileError(f"cannot read GeoJSON {path}: {exc.__class__.__name__}: {exc}", where,
+                             "give a valid GeoJSON FeatureCollection (RFC 7946)") from None
+    parts = shapely.get_parts(geoms) if len(geoms) else geoms
+    wanted = [t for kind in kinds for t in _KINDS[kind]]
+    kept = parts[np.isin(shapely.get_type_id(parts), wanted) & ~shapely.is_empty(parts)] if len(parts) else parts
+    if len(parts) and not len(kept):
+        raise InputFileError(f"GeoJSON {path} holds no {' or '.join(kinds)} geometry", where,
+                             f"give {' or '.join(kinds)} features")
+    return list(kept)
+
+
+def _open(path: Path, where: str):
+    if not path.is_file():
+        raise InputFileError(f"GeoTIFF not found: {path}", where, "give the path of a GeoTIFF raster")
+    try:
+        return rasterio.open(path)
+    except rasterio.errors.RasterioError as exc:
+        raise InputFileError(f"cannot read GeoTIFF {path}: {exc}", where, "give a valid GeoTIFF raster") from None
+
+
+def _dsm_path(scenario: "Scenario") -> Path:
+    if not scenario.city.dsm:
+        raise ScenarioError("city.source is 'dsm' but no DSM GeoTIFF is given", "city.dsm",
+                            "set city.dsm to the path of a GeoTIFF digital surface model")
+    return scenario.resolve_path(scenario.city.dsm)
+
+
+def _check_frame(src, path: Path) -> tuple[float, float, float, float]:
+    """(left, bottom, right, top) of a north-up raster in a metric projected CRS."""
+    fix = "reproject it to a projected CRS in metres, e.g. gdalwarp -t_srs EPSG:32633 in.tif out.tif"
+    if src.crs is None:
+        raise InputFileError(f"GeoTIFF {path} has no coordinate reference system", "city.dsm", fix)
+    if not src.crs.is_projected or (src.crs.linear_units or "").lower() not in ("metre", "meter", "m"):
+        raise InputFileError(f"GeoTIFF {path} is not in a projected CRS in metres ({src.crs})", "city.dsm", fix)
+    t = src.transform
+    if t.b != 0 or t.d != 0 or t.e >= 0:
+        raise InputFileError(f"GeoTIFF {path} is rotated or not north-up", "city.dsm",
+                             "resample it to a north-up raster, e.g. gdalwarp in.tif out.tif")
+    return tuple(src.bounds)
+
+
+def dsm_extent(scenario: "Scenario") -> tuple[float, float]:
+    """(x_max, y_max) of the DSM in the local frame: the raster's width and height, m."""
+    path = _dsm_path(scenario)
+    with _open(path, "city.dsm") as src:
+        left, bottom, right, top = _check_frame(src, path)
+    return right - left, top - bottom
+
+
+def _on_grid(src, grid: "AirspaceGrid", frame: tuple, resampling: Resampling) -> np.ndarray:
+    """Band 1 of ``src`` on the grid's columns, (nx, ny) indexed [i, j] with j northward; NaN outside.
+
+    ``frame`` = (crs, left, bottom) of the local frame: the DSM's CRS and its south-west corner, m.
+    """
+    crs, left, bottom = frame
+    nx, ny = grid.shape[:2]
+    dx, dy = grid.cell[:2]
+    # North-up destination: row 0 is the northernmost row of columns, so flip rows then transpose.
+    dst_transform = Affine(dx, 0.0, left, 0.0, -dy, bottom + ny * dy)
+    rows_cols = np.full((ny, nx), np.nan)
+    try:
+        reproject(rasterio.band(src, 1), rows_cols, src_nodata=src.nodata, dst_transform=dst_transform,
+                  dst_crs=crs, dst_nodata=np.nan, resampling=resampling)
+    except rasterio.errors.RasterioError as exc:
+        raise InputFileError(f"cannot resample GeoTIFF {src.name}: {exc}", "city.dsm", "check the raster") from None
+    return np.ascontiguousarray(rows_cols[::-1].T)
+
+
+def load_dsm(scenario: "Scenario", grid: "AirspaceGrid") -> CityLayers:
+    """The scenario's DSM city on the grid's columns.
+
+    Returns
+    -------
+    CityLayers
+        surface and building heights (m above the ground datum), road length l_r (m), c_s, no-fly.
+
+    Raises
+    ------
+    ScenarioError
+        No ``city.dsm`` given.
+    InputFileError
+        A GeoTIFF or GeoJSON is missing, unreadable, or the DSM is not in a metric projected CRS.
+    """
+    cfg = scenario.city
+    path = _dsm_path(scenario)
+    with _open(path, "city.dsm") as src:
+        left, bottom, _, _ = _check_frame(src, path)
+        crs = src.crs
+        dsm = _on_grid(src, grid, (crs, left, bottom), Resampling.max)
+        if cfg.ground_m is not None:
+            ground = float(cfg.ground_m)
+        else:
+            values = src.read(1, masked=True)
+            values = np.ma.masked_invalid(values)
+            if values.count() == 0:
+                raise InputFileError(f"GeoTIFF {path} holds no valid data", "city.dsm", "check its nodata value")
+            ground = float(values.min())
+    surface = np.nan_to_num(np.maximum(dsm - ground, 0.0), nan=0.0)  # outside the raster: ground
+    building = np.where(surface > cfg.building_min_height_m, surface, 0.0)
+
+    if cfg.shelter:
+        spath = scenario.resolve_path(cfg.shelter)
+        with _open(spath, "city.shelter") as src:
+            shelter = _on_grid(src, grid, (crs, left, bottom), Resampling.average)
+        shelter = np.where(np.isnan(shelter), shelter_rule(building, cfg), shelter)
+    else:
+        shelter = shelter_rule(building, cfg)
+
+    def local(geoms: list) -> list:
+        return list(shapely.transform(np.asarray(geoms, dtype=object), lambda xy: xy - np.array([left, bottom])))
+
+    roads, no_fly = [], []
+    if cfg.roads:
+        roads = local(read_geojson(scenario.resolve_path(cfg.roads), "city.roads", ("LineString",)))
+    if cfg.no_fly:
+        no_fly = local(read_geojson(scenario.resolve_path(cfg.no_fly), "city.no_fly", ("Polygon",)))
+    return CityLayers(
+        surface_height=surface,
+        building_height=building,
+        road_length=segment_length_per_cell(line_segments(roads), grid),
+        population_density=np.full((grid.shape[0], grid.shape[1]), cfg.population_density),
+        shelter=shelter,
+        no_fly=burn_mask(no_fly, grid),
+        open_space=np.zeros((grid.shape[0], grid.shape[1]), dtype=bool),
+        source="dsm",
+        crs=crs.to_string(),
+        origin=(float(left), float(bottom)),
+        notes={"ground_m": ground, "dsm_file": str(path), "roads": len(roads), "no_fly_zones": len(no_fly)},
+    )

@@ -1,0 +1,42 @@
+"""Named exceptions. The CLI turns every :class:`UamoptError` into one line and exit code 2.
+
+Every message follows INTERFACES.md: ``<what> (<where>): <how to fix>``.
+"""
+
+from __future__ import annotations
+
+
+class UamoptError(Exception):
+    """Base class of every error caused by the user's input or a model that cannot be solved."""
+
+    def __init__(self, what: str, where: str = "", fix: str = "") -> None:
+        self.what, self.where, self.fix = what, where, fix
+        super().__init__(self.line())
+
+    def line(self) -> str:
+        text = self.what
+        if self.where:
+            text += f" ({self.where})"
+        if self.fix:
+            text += f": {self.fix}"
+        return text
+
+
+class ScenarioError(UamoptError):
+    """A scenario file or ``--set`` override is malformed, unknown or out of range."""
+
+
+class InputFileError(UamoptError):
+    """An input data file (.pbf, GeoTIFF, GeoJSON, flights.json) is missing or unreadable."""
+
+
+class GridError(UamoptError):
+    """The airspace grid is empty or a point lies outside it."""
+
+
+class NoTrackError(UamoptError):
+    """No admissible track joins the requested origin and destination."""
+
+
+class InfeasibleScheduleError(UamoptError):
+    """No schedule satisfies the constraints."""

@@ -1,0 +1,135 @@
+"""The airspace grid of Sec. 3.
+
+Local metric frame: x east, y north, z altitude above the ground datum, metres. Cell (i, j, k) is
+0-based; its centre is ((i + ½)Δx, (j + ½)Δy, (k + ½)Δz), which is the paper's
+x = (i − ½)Δx with its 1-based i (MODEL_NOTES). The grid holds a = ⌊x_max/Δx⌋ × b × c whole cells.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from uamopt.errors import GridError
+
+if TYPE_CHECKING:
+    from uamopt.scenario import Scenario
+
+
+@dataclass(frozen=True)
+class AirspaceGrid:
+    """A regular grid of ``shape`` = (nx, ny, nz) cells of size ``cell`` = (Δx, Δy, Δz) metres.
+
+    Examples
+    --------
+    >>> g = AirspaceGrid(cell=(50.0, 50.0, 30.0), shape=(50, 90, 12))
+    >>> g.centre_of((1, 2, 3))
+    (75.0, 125.0, 105.0)
+    >>> g.index_of((75.0, 125.0, 105.0))
+    (1, 2, 3)
+    """
+
+    cell: tuple[float, float, float]
+    shape: tuple[int, int, int]
+
+    def __post_init__(self) -> None:
+        if any(c <= 0 for c in self.cell):
+            raise GridError(f"cell size must be positive, got {self.cell}", "grid.cell", "use e.g. [50, 50, 30]")
+        if any(n <= 0 for n in self.shape):
+            raise GridError(
+                f"the domain holds no cells (shape {self.shape})",
+                "grid.extent / grid.cell",
+                "make each extent at least one cell size",
+            )
+
+    @classmethod
+    def from_extent(cls, cell: tuple[float, float, float], extent: tuple[float, float, float]) -> "AirspaceGrid":
+        """The largest grid of whole cells inside [0, x_max] × [0, y_max] × [0, z_max]."""
+        shape = tuple(int(np.floor(e / c + 1e-9)) for e, c in zip(extent, cell))
+        return cls(cell=tuple(float(c) for c in cell), shape=shape)  # type: ignore[arg-type]
+
+    # --- geometry -------------------------------------------------------------------------
+    @property
+    def n_cells(self) -> int:
+        return int(np.prod(self.shape))
+
+    @property
+    def extent(self) -> tuple[float, float, float]:
+        """(x_max, y_max, z_max) actually covered by whole cells, m."""
+        return tuple(n * c for n, c in zip(self.shape, self.cell))  # type: ignore[return-value]
+
+    def centres(self, axis: int) -> np.ndarray:
+        """Cell-centre coordinates along one axis (0 = x, 1 = y, 2 = z), m."""
+        return (np.arange(self.shape[axis]) + 0.5) * self.cell[axis]
+
+    def edges(self, axis: int) -> np.ndarray:
+        """Cell-face coordinates along one axis, ``shape[axis] + 1`` values, m."""
+        return np.arange(self.shape[axis] + 1) * self.cell[axis]
+
+    @property
+    def x(self) -> np.ndarray:
+        return self.centres(0)
+
+    @property
+    def y(self) -> np.ndarray:
+        return self.centres(1)
+
+    @property
+    def z(self) -> np.ndarray:
+        return self.centres(2)
+
+    def centre_of(self, index: tuple[int, int, int]) -> tuple[float, float, float]:
+        """Centre of cell (i, j, k), m."""
+        return tuple(float((i + 0.5) * c) for i, c in zip(index, self.cell))  # type: ignore[return-value]
+
+    def indices_of(self, points: np.ndarray) -> np.ndarray:
+        """Cell indices (…, 3) of points (…, 3) in metres; points on a face go to the upper cell.
+
+        Raises
+        ------
+        GridError
+            If any point lies outside the grid.
+        """
+        pts = np.asarray(points, dtype=float)
+        idx = np.floor(pts / np.asarray(self.cell)).astype(np.int64)
+        # a point exactly on the far boundary belongs to the last cell
+        idx = np.where(pts == np.asarray(self.extent), idx - 1, idx)
+        bad = np.any((idx < 0) | (idx >= np.asarray(self.shape)), axis=-1)
+        if np.any(bad):
+            first = pts.reshape(-1, 3)[np.flatnonzero(bad.reshape(-1))[0]]
+            raise GridError(
+                f"point {tuple(float(v) for v in first)} is outside the grid",
+                f"extent {self.extent}",
+                "choose a point inside the domain",
+            )
+        return idx
+
+    def index_of(self, point: tuple[float, float, float]) -> tuple[int, int, int]:
+        """Cell index (i, j, k) of one point in metres."""
+        return tuple(int(v) for v in self.indices_of(np.asarray(point, dtype=float)))  # type: ignore[return-value]
+
+    def layers_in_band(self, low_m: float, high_m: float) -> np.ndarray:
+        """Layer indices k whose centre altitude satisfies low ≤ z_k ≤ high (Eq. 14)."""
+        z = self.z
+        return np.flatnonzero((z >= low_m - 1e-9) & (z <= high_m + 1e-9))
+
+
+def altitude_band(scenario: "Scenario") -> tuple[float, float]:
+    """max(h_min, h'_min) ≤ h ≤ min(h_max, h'_max) (Eq. 14), m. Default [90, 300]."""
+    low = max(scenario.aircraft.h_min, scenario.grid.h_min_airspace)
+    high = min(scenario.aircraft.h_max, scenario.grid.h_max_airspace)
+    return low, high
+
+
+def build_grid(scenario: "Scenario") -> AirspaceGrid:
+    """The scenario's grid; with no ``grid.extent`` the city source's own extent is used."""
+    from uamopt.city import source_extent
+
+    if scenario.grid.extent is not None:
+        extent = scenario.grid.extent
+    else:
+        ex, ey = source_extent(scenario)
+        extent = (ex, ey, scenario.grid.h_max_airspace)
+    return AirspaceGrid.from_extent(scenario.grid.cell, extent)

@@ -1,0 +1,288 @@
+"""Operational risk field (Sec. 4.1.1, App. A): Eqs. 1–9 and A.1–A.9, vectorised over every cell.
+
+Readings (MODEL_NOTES):
+
+- Each cell is evaluated separately; h' = centre altitude − surface height under it. A cell any
+  part of which lies below the surface (inside or under a building) is an obstacle; its
+  continuous risk values are NaN ("not airspace") and it is unsafe in Eq. 9.
+- A.3 is the speed after a fall from rest through h' with quadratic drag,
+  v² = (g/k)(1 − e^{−2kh'}), k = R_I ρ_a S_e / (2(m_e + m_p)); the fall time is
+  t = arccosh(e^{kh'}) / √(gk). S_e = πd²/4 is both the crash disc (Eq. 2) and the frontal area.
+- R^V uses l_r = road length inside the column's footprint; R^V = λ ρ_V l_r · S_v ρ_V / w_r.
+- R^U = λ ρ_U V_e with V_e = e_w e_h (v_r' t + e_l) (A.4–A.5) and v_r' the A.6 average of A.9,
+  computed once by Gauss–Legendre quadrature (v_r does not depend on time, so the time average
+  is the identity).
+- λ and therefore R and R_0 are per flight hour; λ is not converted.
+
+Known weaknesses, reported rather than hidden: R^V grows with the cell side (l_r is per cell),
+and with Table B.3 values any column over a road exceeds R_0 while open ground never does.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from functools import lru_cache
+from pathlib import Path
+
+import numpy as np
+from scipy.special import expit
+
+from uamopt.city.layers import CityLayers
+from uamopt.grid import AirspaceGrid, altitude_band
+from uamopt.scenario import Scenario
+
+# --- physical models (one function each, SI units) -----------------------------------------
+
+
+def crash_area(diameter_m: float) -> float:
+    """S_e = π d² / 4, m² (Eq. 2): crash disc, also the frontal area of A.2–A.3."""
+    return math.pi * diameter_m**2 / 4.0
+
+
+def drag_constant(mass_kg: float, drag_coefficient: float, air_density: float, area_m2: float) -> float:
+    """k = R_I ρ_a S_e / (2 m), 1/m, so that dv/dt = g − k v² (A.2)."""
+    return drag_coefficient * air_density * area_m2 / (2.0 * mass_kg)
+
+
+def terminal_speed(k: float, g: float) -> float:
+    """√(g/k), m/s: the limit of A.3 as h' → ∞."""
+    return math.sqrt(g / k)
+
+
+def impact_speed(height_m, k: float, g: float):
+    """Impact speed after a drag-limited fall from rest through ``height_m`` (Eq. A.3), m/s.
+
+    v = √((g/k)(1 − e^{−2kh'})), written with ``expm1`` so small heights keep full precision.
+    """
+    return np.sqrt(-(g / k) * np.expm1(-2.0 * k * np.asarray(height_m, dtype=float)))
+
+
+def fall_time(height_m, k: float, g: float):
+    """Time to fall ``height_m`` from rest with quadratic drag, s: t = arccosh(e^{kh'}) / √(gk).
+
+    Evaluated as (kh' + ln(1 + √(1 − e^{−2kh'}))) / √(gk), which does not overflow.
+    """
+    x = k * np.asarray(height_m, dtype=float)
+    return (x + np.log1p(np.sqrt(-np.expm1(-2.0 * x)))) / math.sqrt(g * k)
+
+
+def impact_energy(mass_kg: float, speed_mps):
+    """E_imp = ½ (m_e + m_p) v², J (Eq. A.1)."""
+    return 0.5 * mass_kg * np.asarray(speed_mps, dtype=float) ** 2
+
+
+def fatality_probability(energy_j, shelter, alpha_j: float, beta_j: float):
+    """P^P = 1 / (1 + √(α/β) (β/E_imp)^{1/(4 c_s)}) (Eq. 3).
+
+    Computed as expit(−[½ ln(α/β) + ln(β/E)/(4 c_s)]). The limit c_s → 0 is taken exactly:
+    P = 1 when E > β, 0 when E < β, 1/(1 + √(α/β)) when E = β; no division by zero.
+    """
+    energy = np.asarray(energy_j, dtype=float)
+    cs = np.asarray(shelter, dtype=float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        inv = np.where(cs > 0, 1.0 / (4.0 * np.where(cs > 0, cs, 1.0)), np.inf)
+        term = np.log(beta_j / energy) * inv
+    term = np.where(np.isnan(term), 0.0, term)
+    return expit(-(0.5 * math.log(alpha_j / beta_j) + term))
+
+
+def relative_speed(v_e, v_u: float, theta: float, gamma, epsilon):
+    """v_r between the aircraft and a UAV (Eq. A.9), m/s."""
+    return np.sqrt(
+        v_e**2 + v_u**2
+        + 2.0 * v_e * v_u * (math.cos(theta) * np.cos(gamma) * np.cos(epsilon) - math.sin(theta) * np.sin(gamma))
+    )
+
+
+@lru_cache(maxsize=64)
+def mean_relative_speed(v_min: float, v_max: float, v_u: float, theta: float, points: int = 64) -> float:
+    """v_r' (Eq. A.6): the mean of A.9 over v_e ∈ [v_min, v_max], γ ∈ (−π/2, π/2), ε ∈ (0, π), m/s.
+
+    The normalisation 1/(π² t (v_max − v_min)) of A.6 is exactly this average (the integrand does
+    not depend on t). Tensor Gauss–Legendre quadrature with ``points`` nodes per axis; the
+    integrand is smooth because v_e > v_U keeps v_r > 0.
+    """
+    nodes, weights = np.polynomial.legendre.leggauss(points)
+
+    def on(a: float, b: float):
+        return 0.5 * (b - a) * nodes + 0.5 * (b + a), 0.5 * (b - a) * weights
+
+    ve, wv = on(v_min, v_max)
+    ga, wg = on(-math.pi / 2, math.pi / 2)
+    ep, we = on(0.0, math.pi)
+    vr = relative_speed(ve[:, None, None], v_u, theta, ga[None, :, None], ep[None, None, :])
+    total = np.einsum("i,j,k,ijk->", wv, wg, we, vr)
+    return float(total / (math.pi**2 * (v_max - v_min)))
+
+
+def swept_volume(fall_time_s, mean_speed_mps: float, length_m: float, width_m: float, height_m: float):
+    """V_e = e_w e_h (v_r' t + e_l), m³ (Eq. A.5)."""
+    return width_m * height_m * (mean_speed_mps * np.asarray(fall_time_s, dtype=float) + length_m)
+
+
+def vehicle_collision_probability(vehicle_area_m2: float, traffic_density_per_m: float, road_width_m: float) -> float:
+    """P^V = S_v ρ_V / w_r (Eq. 5)."""
+    return vehicle_area_m2 * traffic_density_per_m / road_width_m
+
+
+# --- the field -------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class RiskConstants:
+    """Scalars of the risk model derived once from the scenario."""
+
+    mass_kg: float  # m_e + m_p
+    crash_area_m2: float  # S_e
+    k_per_m: float  # drag constant of A.2
+    terminal_speed_mps: float
+    mean_relative_speed_mps: float  # v_r' (A.6)
+    vehicle_collision_probability: float  # P^V (Eq. 5)
+
+    @classmethod
+    def from_scenario(cls, scenario: Scenario) -> "RiskConstants":
+        a, r = scenario.aircraft, scenario.risk
+        mass = a.empty_mass_kg + a.payload_kg
+        area = crash_area(a.length_m)
+        k = drag_constant(mass, r.drag_coefficient, r.air_density, area)
+        return cls(
+            mass_kg=mass,
+            crash_area_m2=area,
+            k_per_m=k,
+            terminal_speed_mps=terminal_speed(k, r.gravity_mps2),
+            mean_relative_speed_mps=mean_relative_speed(
+                a.speed_min_mps, a.speed_max_mps, r.uav_speed_mps, a.climb_angle_rad, r.quadrature_points
+            ),
+            vehicle_collision_probability=vehicle_collision_probability(
+                r.vehicle_area_m2, r.traffic_density_per_m, r.road_width_m
+            ),
+        )
+
+
+@dataclass(frozen=True)
+class RiskField:
+    """The risk field on the grid. 3-D arrays have shape (nx, ny, nz).
+
+    ``risk`` is Eq. 8 and ``risk_P``, ``risk_V``, ``risk_U`` its terms (per flight hour; NaN in
+    obstacle cells); ``unsafe`` is Eq. 9 (risk > R_0, obstacle or no-fly); ``obstacle`` marks
+    cells inside or below a building.
+    """
+
+    grid: AirspaceGrid
+    city: CityLayers
+    risk: np.ndarray
+    risk_P: np.ndarray
+    risk_V: np.ndarray
+    risk_U: np.ndarray
+    unsafe: np.ndarray
+    obstacle: np.ndarray
+    band: tuple[float, float]
+    constants: RiskConstants
+    threshold: float
+    seconds: float = 0.0
+    meta: dict = field(default_factory=dict)
+
+    @property
+    def no_fly(self) -> np.ndarray:
+        """No-fly cells (bool, (nx, ny, nz)): every layer above a no-fly column."""
+        return np.broadcast_to(self.city.no_fly[:, :, None], self.grid.shape)
+
+    @property
+    def binary(self) -> np.ndarray:
+        """Eq. 9 as 0/1 floats: the field the planner uses by default."""
+        return self.unsafe.astype(float)
+
+    def band_layers(self) -> np.ndarray:
+        """Layer indices inside the altitude band of Eq. 14."""
+        return self.grid.layers_in_band(*self.band)
+
+    def arrays(self) -> dict[str, np.ndarray]:
+        """The arrays of ``risk.npz`` (INTERFACES.md)."""
+        g = self.grid
+        return {
+            "risk": self.risk, "risk_P": self.risk_P, "risk_V": self.risk_V, "risk_U": self.risk_U,
+            "unsafe": self.unsafe, "obstacle": self.obstacle, "no_fly": self.city.no_fly,
+            "x": g.x, "y": g.y, "z": g.z, "cell": np.asarray(g.cell),
+            "surface_height": self.city.surface_height, "building_height": self.city.building_height,
+            "shelter": self.city.shelter, "road_length": self.city.road_length,
+            "population_density": self.city.population_density,
+        }
+
+    def save_npz(self, path: str | Path) -> None:
+        np.savez_compressed(path, **self.arrays())
+
+
+def risk_field(scenario: Scenario, grid: AirspaceGrid, city: CityLayers) -> RiskField:
+    """Compute Eqs. 1–9 for every cell of ``grid`` over ``city``.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        Risk (Table B.3) and aircraft parameters.
+    grid : AirspaceGrid
+        The cells.
+    city : CityLayers
+        Column layers on ``grid``'s footprint.
+
+    Returns
+    -------
+    RiskField
+
+    Examples
+    --------
+    >>> from uamopt import Scenario, AirspaceGrid, risk_field
+    >>> from uamopt.city.layers import CityLayers
+    >>> import numpy as np
+    >>> g = AirspaceGrid(cell=(50.0, 50.0, 30.0), shape=(2, 1, 10))
+    >>> zeros = np.zeros((2, 1))
+    >>> city = CityLayers(zeros, zeros, np.array([[0.0], [50.0]]), zeros + 2.5e-4, zeros + 0.5,
+    ...                   zeros > 0, zeros > 0, source="doc")
+    >>> f = risk_field(Scenario(), g, city)
+    >>> bool(f.unsafe[0, 0, 4]), bool(f.unsafe[1, 0, 4])   # open ground vs above a 50 m road
+    (False, True)
+    """
+    started = time.perf_counter()
+    r, c = scenario.risk, RiskConstants.from_scenario(scenario)
+    g, lam = r.gravity_mps2, r.failure_rate_per_h
+    zc = grid.z
+    surface = city.surface_height[:, :, None]
+    # h' per cell (MODEL_NOTES); an obstacle is any cell reaching below the surface.
+    height = zc[None, None, :] - surface
+    obstacle = (zc - 0.5 * grid.cell[2])[None, None, :] < surface - 1e-9
+    height = np.where(obstacle, np.nan, height)
+
+    # Ground personnel: R^P = λ ρ_P S_e P^P (Eqs. 1-3, A.1-A.3).
+    decay = np.exp(-2.0 * c.k_per_m * height)  # e^{-2kh'}, shared by A.3 and the fall time
+    with np.errstate(divide="ignore", invalid="ignore"):
+        log_speed_sq = math.log(g / c.k_per_m) + np.log1p(-decay)
+        log_energy = math.log(0.5 * c.mass_kg) + log_speed_sq
+        cs = city.shelter[:, :, None]
+        inv4cs = np.where(cs > 0, 1.0 / (4.0 * np.where(cs > 0, cs, 1.0)), np.inf)
+        term = (math.log(r.beta_j) - log_energy) * inv4cs
+    term = np.where(np.isnan(term) & ~obstacle, 0.0, term)  # c_s = 0 and E = β exactly
+    p_people = expit(-(0.5 * math.log(r.alpha_j / r.beta_j) + term))
+    risk_p = (lam * c.crash_area_m2) * city.population_density[:, :, None] * p_people
+
+    # Ground vehicles: R^V = λ ρ_V l_r P^V (Eqs. 4-5): constant up the column.
+    risk_v_col = lam * r.traffic_density_per_m * city.road_length * c.vehicle_collision_probability
+    risk_v = np.where(obstacle, np.nan, risk_v_col[:, :, None])
+
+    # UAVs: R^U = λ ρ_U e_w e_h (v_r' t + e_l) (A.4-A.5), t the fall time from h'.
+    with np.errstate(invalid="ignore"):
+        t_fall = (c.k_per_m * height + np.log1p(np.sqrt(1.0 - decay))) / math.sqrt(g * c.k_per_m)
+    a = scenario.aircraft
+    risk_u = (lam * r.uav_density_per_m3 * a.wingspan_m * a.height_m) * (
+        c.mean_relative_speed_mps * t_fall + a.fuselage_length_m
+    )
+
+    w1, w2, w3 = r.weights
+    risk = w1 * risk_p + w2 * risk_v + w3 * risk_u  # Eq. 8
+    with np.errstate(invalid="ignore"):
+        unsafe = (risk > r.threshold) | obstacle | city.no_fly[:, :, None]  # Eq. 9
+    return RiskField(
+        grid=grid, city=city, risk=risk, risk_P=risk_p, risk_V=risk_v, risk_U=risk_u,
+        unsafe=unsafe, obstacle=obstacle, band=altitude_band(scenario), constants=c,
+        threshold=r.threshold, seconds=time.perf_counter() - started,
+    )

