@@ -16,7 +16,7 @@ import tomllib
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, PrivateAttr, ValidationError, model_validator
+from pydantic import BaseModel, ConfigDict, Field, PrivateAttr, ValidationError, ValidationInfo, field_validator
 
 from uamopt.errors import ScenarioError
 
@@ -83,7 +83,9 @@ class AircraftConfig(_Section):
     height_m: PositiveFloat = Field(1.855, description="e_h, m (A.5)")
     speed_min_mps: PositiveFloat = Field(10.0, description="v_e min, m/s (A.6)")
     speed_max_mps: PositiveFloat = Field(130.0 / 3.6, description="v_e max, m/s (130 km/h, A.6)")
-    climb_angle_rad: float = Field(math.pi / 6, description="θ, angle of v_e to the xy plane, rad (A.7-A.9)")
+    climb_angle_rad: float = Field(
+        math.pi / 6, gt=-math.pi / 2, lt=math.pi / 2, description="θ, angle of v_e to the xy plane, rad (A.7-A.9)"
+    )
     cruise_speed_mps: PositiveFloat = Field(25.0, description="v_g, m/s (Eq. 23)")
     h_min: NonNegFloat = Field(90.0, description="h_min, aircraft minimum altitude, m (Eq. 14)")
     h_max: PositiveFloat = Field(3000.0, description="h_max, aircraft maximum altitude, m (Eq. 14)")
@@ -94,13 +96,12 @@ class AircraftConfig(_Section):
     c_e: PositiveFloat = Field(5.96e-7, description="c_e, energy price, ¥/J (Eq. 12)")
     tau_max: NonNegFloat = Field(1.56, description="τ_max, full-load factor (Eq. 13)")
 
-    @model_validator(mode="after")
-    def _check(self) -> "AircraftConfig":
-        if self.speed_max_mps <= self.speed_min_mps:
-            raise ValueError("speed_max_mps must exceed speed_min_mps")
-        if not -math.pi / 2 < self.climb_angle_rad < math.pi / 2:
-            raise ValueError("climb_angle_rad must lie in (-π/2, π/2)")
-        return self
+    @field_validator("speed_max_mps")
+    @classmethod
+    def _above_min(cls, value: float, info: ValidationInfo) -> float:
+        if value <= info.data.get("speed_min_mps", 0.0):
+            raise ValueError("must exceed speed_min_mps")
+        return value
 
 
 class RiskConfig(_Section):
@@ -148,15 +149,22 @@ class NetworkConfig(_Section):
         150.0, description="radius kept free of buildings above h_min around each vertiport (synthetic city), m"
     )
 
-    @model_validator(mode="after")
-    def _check(self) -> "NetworkConfig":
-        names = [v.name for v in self.vertiports]
+    @field_validator("vertiports")
+    @classmethod
+    def _unique(cls, value: tuple[Vertiport, ...]) -> tuple[Vertiport, ...]:
+        names = [v.name for v in value]
         if len(set(names)) != len(names):
             raise ValueError("vertiport names must be unique")
-        for a, b in self.routes or ():
+        return value
+
+    @field_validator("routes")
+    @classmethod
+    def _known(cls, value, info: ValidationInfo):
+        names = [v.name for v in info.data.get("vertiports", ())]
+        for a, b in value or ():
             if a not in names or b not in names or a == b:
-                raise ValueError(f"route ({a}, {b}) must join two different vertiports of {names}")
-        return self
+                raise ValueError(f"route ({a}, {b}) must join two different vertiports of {', '.join(names)}")
+        return value
 
 
 class TracksConfig(_Section):
@@ -245,6 +253,21 @@ def _apply_overrides(raw: dict, overrides: list[str]) -> dict:
     return raw
 
 
+def _field_info(loc: tuple):
+    """The pydantic FieldInfo at a validation-error location, or None."""
+    model: Any = Scenario
+    info = None
+    for part in loc:
+        if not isinstance(part, str) or model is None:
+            continue
+        info = model.model_fields.get(part)
+        if info is None:
+            return None
+        ann = info.annotation
+        model = ann if isinstance(ann, type) and issubclass(ann, BaseModel) else None
+    return info
+
+
 def _section_keys(loc: tuple) -> list[str]:
     model: Any = Scenario
     for part in loc[:-1]:
@@ -272,9 +295,11 @@ def _validate(raw: dict, source: str, base_dir: Path, overrides: list[str]) -> S
             fix = f"valid keys in [{section}] are {', '.join(valid)}" if valid else "remove it"
             raise ScenarioError(f"unknown key '{key}'", where, fix) from None
         value = err.get("input")
-        shown = repr(value) if not isinstance(value, dict) else "a table"
+        shown = f" {value!r}" if not isinstance(value, (dict, list, tuple)) or len(repr(value)) < 60 else ""
         msg = err["msg"].replace("Value error, ", "")
-        raise ScenarioError(f"invalid value {shown} for '{key}': {msg}", where, "see the key's description in uamopt/scenario.py") from None
+        info = _field_info(loc)
+        fix = f"'{key}' is {info.description}" if info is not None and info.description else "see uamopt/scenario.py"
+        raise ScenarioError(f"invalid value{shown} for '{key}': {msg}", where, fix) from None
     scenario._base_dir = base_dir
     scenario._source = source
     return scenario

@@ -23,7 +23,7 @@ import pandas as pd
 import shapely
 from pyproj import Transformer
 
-from uamopt.city.dsm import read_geojson
+from uamopt.city.geojson import read_geojson
 from uamopt.city.layers import VectorCity
 from uamopt.errors import InputFileError, ScenarioError
 
@@ -143,7 +143,7 @@ def _load_cached(path: str, mtime_ns: int, bbox: tuple | None, storey_height_m: 
     if buildings is None or len(buildings) == 0:
         where = f"city.bbox {list(bbox)}" if bbox else "city.pbf"
         raise InputFileError(f"no buildings in the OpenStreetMap data of {path}", where,
-                             "choose a bounding box that covers part of the city in the file")
+                             "choose a [west, south, east, north] box that covers part of the city in the file")
     heights, counts = building_heights(buildings, storey_height_m, default_height_m)
 
     if bbox is not None:

@@ -1,0 +1,112 @@
+"""End-to-end: the commands as a user runs them, and the one-line errors of INTERFACES.md."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+PAPER = str(ROOT / "models" / "paper_case.toml")
+
+
+def run(*args: str, cwd: Path = ROOT) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "uamopt", *args], cwd=cwd, capture_output=True, text=True, timeout=300)
+
+
+def assert_one_line_error(proc: subprocess.CompletedProcess, fragment: str) -> None:
+    assert proc.returncode == 2, proc.stderr
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1, proc.stderr
+    assert lines[0].startswith("error: ") and fragment in lines[0], lines[0]
+    assert "Traceback" not in proc.stderr
+
+
+def test_risk_command_writes_the_interface_files(tmp_path):
+    out = tmp_path / "risk"
+    proc = run("risk", PAPER, "--out", str(out), "--set", "grid.cell=[100,100,60]")
+    assert proc.returncode == 0, proc.stderr
+    assert sorted(p.name for p in out.iterdir()) == ["risk.npz", "risk.png", "summary.json"]
+    summary = json.loads((out / "summary.json").read_text())
+    with np.load(out / "risk.npz") as data:
+        assert data["risk"].shape == (25, 45, 6) == tuple(summary["grid"]["shape"])
+        assert int(data["unsafe"].sum()) == summary["unsafe_cells"]
+        assert int(data["obstacle"].sum()) == summary["obstacle_cells"]
+    assert summary["cells"] == 25 * 45 * 6 and 0 < summary["unsafe_share"] < 1
+    assert summary["constants"]["mean_relative_speed_mps"] == pytest.approx(23.664, abs=5e-4)
+    assert summary["seconds"]["risk"] > 0
+    assert (out / "risk.png").stat().st_size > 10_000
+
+
+def test_reproduce_writes_the_report(tmp_path):
+    out = tmp_path / "paper"
+    proc = run("reproduce", PAPER, "--out", str(out))
+    assert proc.returncode == 0, proc.stderr
+    assert "report.md" in proc.stdout
+    report = (out / "report.md").read_text()
+    assert "Operational risk field" in report and "![risk map](risk.png)" in report
+    assert "27.4684" in report  # terminal speed at m_p = 0 beside the reference 27.468
+    assert {"risk.npz", "risk.png", "summary.json", "report.md"} <= {p.name for p in out.iterdir()}
+
+
+def test_helsinki_from_openstreetmap(tmp_path):
+    out = tmp_path / "hel"
+    proc = run("risk", str(ROOT / "models" / "helsinki.toml"), "--out", str(out), "--set", "grid.cell=[40,40,30]")
+    assert proc.returncode == 0, proc.stderr
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["source"] == "osm" and "OpenStreetMap" in summary["attribution"]
+    assert summary["obstacle_cells"] > 0 and summary["unsafe_share"] > 0
+
+
+def test_same_seed_same_field(tmp_path):
+    a, b = tmp_path / "a", tmp_path / "b"
+    for out in (a, b):
+        assert run("risk", PAPER, "--out", str(out), "--set", "grid.cell=[100,100,60]").returncode == 0
+    with np.load(a / "risk.npz") as x, np.load(b / "risk.npz") as y:
+        for name in x.files:
+            assert np.array_equal(x[name], y[name], equal_nan=True), name
+
+
+@pytest.fixture
+def bad_toml(tmp_path):
+    def write(text: str) -> str:
+        path = tmp_path / "bad.toml"
+        path.write_text(text)
+        return str(path)
+    return write
+
+
+@pytest.mark.parametrize("text, extra, fragment", [
+    ("[grid\ncell = [1,1,1]", [], "malformed TOML"),
+    ("[grid]\ncelll = [10, 10, 10]", [], "unknown key 'grid.celll'"),
+    ("[grid]\ncell = [-10, 10, 10]", [], "grid.cell"),
+    ("[grid]\ncell = [50, 50, 30]\nextent = [10, 4500, 300]", [], "no cells"),
+    ("[city]\nsource = 'osm'\npbf = 'missing.osm.pbf'", [], "OpenStreetMap file not found"),
+    ("[city]\nsource = 'dsm'\ndsm = 'missing.tif'", [], "missing.tif"),
+    ("", ["grid.cell=[10,10,-1]"], "--set grid.cell"),
+])
+def test_bad_input_one_line_exit_2_nothing_written(tmp_path, bad_toml, text, extra, fragment):
+    out = tmp_path / "out"
+    args = ["risk", bad_toml(text), "--out", str(out)]
+    for item in extra:
+        args += ["--set", item]
+    proc = run(*args)
+    assert_one_line_error(proc, fragment)
+    assert not out.exists()
+
+
+def test_missing_scenario_and_bad_arguments(tmp_path):
+    assert_one_line_error(run("risk", str(tmp_path / "none.toml"), "--out", str(tmp_path / "o")), "not found")
+    assert_one_line_error(run("risk"), "command line")
+    assert_one_line_error(run("frobnicate", PAPER), "command line")
+
+
+def test_out_is_a_file(tmp_path):
+    target = tmp_path / "file.txt"
+    target.write_text("keep me")
+    assert_one_line_error(run("risk", PAPER, "--out", str(target)), "output path is a file")
+    assert target.read_text() == "keep me"

@@ -1,0 +1,78 @@
+"""The networkx reference graph of the airspace."""
+
+from __future__ import annotations
+
+import itertools
+import math
+
+import networkx as nx
+import numpy as np
+import pytest
+
+from uamopt.graph import neighbour_moves, to_networkx
+from uamopt.scenario import load_scenario
+from uamopt.stages import compute_risk
+
+
+@pytest.fixture(scope="module")
+def coarse(root):
+    return compute_risk(load_scenario(root / "models" / "paper_case.toml", ["grid.cell=[100,100,60]"])).field
+
+
+def test_nodes_are_the_passable_cells_with_attributes(coarse):
+    G = to_networkx(coarse)
+    passable = ~(coarse.obstacle | coarse.no_fly)
+    assert G.number_of_nodes() == int(passable.sum())
+    i, j, k = map(int, np.argwhere(passable)[0])
+    data = G.nodes[(i, j, k)]
+    assert data["pos"] == coarse.grid.centre_of((i, j, k))
+    assert data["risk"] == coarse.risk[i, j, k] and data["unsafe"] == bool(coarse.unsafe[i, j, k])
+
+
+def test_edges_match_a_brute_force_enumeration(coarse):
+    """Every edge joins 26-neighbours whose bounding box is free; every such pair is an edge."""
+    G = to_networkx(coarse)
+    passable = ~(coarse.obstacle | coarse.no_fly)
+    shape = passable.shape
+    cell = np.asarray(coarse.grid.cell)
+    expected = set()
+    sub = np.argwhere(passable)
+    for c in map(tuple, sub[:: max(1, len(sub) // 400)]):  # a sample of sources, checked exhaustively
+        for d in itertools.product((-1, 0, 1), repeat=3):
+            if d == (0, 0, 0):
+                continue
+            n = tuple(a + b for a, b in zip(c, d))
+            if not all(0 <= v < s for v, s in zip(n, shape)):
+                continue
+            box_free = all(passable[tuple(a + o for a, o in zip(c, corner))]
+                           for corner in itertools.product(*[(0, x) if x else (0,) for x in d]))
+            assert G.has_edge(c, n) == box_free, (c, n)
+            if box_free:
+                assert G.edges[c, n]["length"] == pytest.approx(float(np.linalg.norm(np.asarray(d) * cell)))
+                expected.add((c, n))
+    assert expected
+
+
+def test_no_corner_cutting_on_a_tiny_grid():
+    passable = np.ones((2, 2, 1), dtype=bool)
+    passable[1, 0, 0] = False
+    moves = neighbour_moves(passable, (1, 1, 0))
+    assert not moves[0, 0, 0]  # the diagonal (0,0) -> (1,1) would cut the blocked (1,0)
+    passable[1, 0, 0] = True
+    assert neighbour_moves(passable, (1, 1, 0))[0, 0, 0]
+
+
+def test_shortest_path_on_the_graph_is_a_valid_track(coarse):
+    G = to_networkx(coarse)
+    s = coarse.grid.index_of((300.0, 300.0, 150.0))
+    t = coarse.grid.index_of((2220.0, 4220.0, 150.0))
+    length = nx.astar_path_length(G, s, t, weight="length")
+    straight = math.dist(coarse.grid.centre_of(s), coarse.grid.centre_of(t))
+    assert straight <= length < 1.5 * straight
+
+
+def test_neighbourhood_choice(coarse):
+    g6, g26 = to_networkx(coarse, neighbourhood=6), to_networkx(coarse, neighbourhood=26)
+    assert g6.number_of_nodes() == g26.number_of_nodes() and g6.number_of_edges() < g26.number_of_edges()
+    with pytest.raises(ValueError):
+        to_networkx(coarse, neighbourhood=8)
