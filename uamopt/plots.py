@@ -102,9 +102,9 @@ def _runs(mask: np.ndarray, xe: np.ndarray, ye: np.ndarray) -> np.ndarray:
     return np.stack([np.column_stack(p) for p in ((x0, y0), (x1, y0), (x1, y1), (x0, y1))], axis=1)
 
 
-def _colorbar_axes(ax):
+def _colorbar_axes(ax, width: float = 0.045, pad: float = 0.03):
     """A colour-bar axes glued to the right of ``ax``'s drawn box (follows an equal aspect)."""
-    return ax.inset_axes([1.03, 0.0, 0.045, 1.0])
+    return ax.inset_axes([1.0 + pad, 0.0, width, 1.0])
 
 
 def _height_cmap() -> colors.ListedColormap:
@@ -112,7 +112,10 @@ def _height_cmap() -> colors.ListedColormap:
     return colors.ListedColormap(matplotlib.colormaps["magma_r"](np.linspace(0.22, 1.0, 256)), name="heights")
 
 
-LEGEND_BELOW = dict(loc="upper center", bbox_to_anchor=(0.5, -0.07), ncol=2, fontsize=7, frameon=False)
+ROAD_OUTLINE_MAX_COLUMNS = 120  # columns across map (a) up to which road columns are outlined
+# below the axes, clear of tick labels and x label (borderaxespad is in font sizes)
+LEGEND_BELOW = dict(loc="upper center", bbox_to_anchor=(0.5, 0.0), borderaxespad=3.4, ncol=2, fontsize=7,
+                    frameon=False)
 
 
 def _vertiport_points(vertiports: Iterable) -> list[tuple[str, float, float]]:
@@ -130,7 +133,9 @@ def _vertiport_points(vertiports: Iterable) -> list[tuple[str, float, float]]:
 
 
 def _default_section_y(field: RiskField, ports: list[tuple[str, float, float]]) -> float:
-    """Midpoint of the first vertiport pair, the single vertiport, or the middle of the grid."""
+    """Midpoint of the first pair of vertiports inside the grid, the only one, or the grid's middle."""
+    ex, ey = field.grid.extent[:2]
+    ports = [p for p in ports if 0.0 <= p[1] <= ex and 0.0 <= p[2] <= ey]
     if len(ports) >= 2:
         return 0.5 * (ports[0][2] + ports[1][2])
     if len(ports) == 1:
@@ -154,10 +159,12 @@ def _draw_vertiports(ax, ports: list[tuple[str, float, float]]) -> None:
     xs = [p[1] for p in ports]
     ys = [p[2] for p in ports]
     ax.scatter(xs, ys, marker="^", s=60, c="white", edgecolors="black", linewidths=1.2, zorder=6)
-    offset = 0.015 * max(ax.get_xlim()[1] - ax.get_xlim()[0], ax.get_ylim()[1] - ax.get_ylim()[0])
-    for name, x, y in ports:  # a handful of labels, not cells
-        ax.annotate(name, (x, y), xytext=(x + offset, y + offset), fontsize=8, fontweight="bold",
-                    zorder=7, path_effects=HALO)
+    ex, ey = ax.get_xlim()[1], ax.get_ylim()[1]
+    for name, x, y in ports:  # a handful of labels, not cells; kept inside the map near its edges
+        east, north = x > 0.7 * ex, y > 0.95 * ey
+        ax.annotate(name, (x, y), xytext=(-5 if east else 5, -5 if north else 5), textcoords="offset points",
+                    ha="right" if east else "left", va="top" if north else "bottom", fontsize=8,
+                    fontweight="bold", zorder=7, path_effects=HALO)
 
 
 def _draw_section_line(ax, y: float, xmax: float) -> None:
@@ -181,8 +188,13 @@ def _panel_risk_map(fig, ax, field, k, norm, cmap, ports, section_y):
     xe, ye = g.edges(0), g.edges(1)
     z0, z1 = k * g.cell[2], (k + 1) * g.cell[2]
     mesh = ax.pcolormesh(xe, ye, _log10(field.risk[:, :, k]).T, cmap=cmap, norm=norm, shading="flat")
-    roads = LineCollection(_outline(city.road_length > 0, xe, ye), colors="white", linewidths=0.35, alpha=0.7)
-    ax.add_collection(roads)
+    # Road columns outlined in white where a cell is wide enough on the page to show a line
+    # inside it; on finer grids the outline would paint over the cells (roads are then the
+    # unsafe lines themselves, and map (b) shows them).
+    outline_roads = g.shape[0] <= ROAD_OUTLINE_MAX_COLUMNS
+    if outline_roads:
+        ax.add_collection(LineCollection(_outline(city.road_length > 0, xe, ye), colors="white",
+                                         linewidths=0.35, alpha=0.7))
     if city.no_fly.any():
         ax.add_collection(PolyCollection(_runs(city.no_fly, xe, ye), facecolors="none", edgecolors="none",
                                          hatch="////", hatchcolor=NO_FLY, zorder=4))
@@ -193,11 +205,12 @@ def _panel_risk_map(fig, ax, field, k, norm, cmap, ports, section_y):
     ax.set_title(f"(a) risk R (Eq. 8) on layer k={k}, z = {z0:g}–{z1:g} m", fontsize=9, loc="left")
     cbar = fig.colorbar(mesh, cax=_colorbar_axes(ax))
     _mark_threshold(cbar, field)
-    ax.legend(handles=[Patch(facecolor=OBSTACLE_GREY, label="building (obstacle)"),
-                       Patch(facecolor="none", edgecolor=NO_FLY, hatch="////", label="no-fly"),
-                       Line2D([], [], color="white", lw=1.0, label="road columns",
-                              path_effects=[patheffects.withStroke(linewidth=2.2, foreground="0.4")])],
-              **LEGEND_BELOW)
+    handles = [Patch(facecolor=OBSTACLE_GREY, label="building (obstacle)"),
+               Patch(facecolor="none", edgecolor=NO_FLY, hatch="////", label="no-fly")]
+    if outline_roads:
+        handles.append(Line2D([], [], color="white", lw=1.0, label="road columns",
+                              path_effects=[patheffects.withStroke(linewidth=2.2, foreground="0.4")]))
+    ax.legend(handles=handles, **LEGEND_BELOW)
 
 
 def _mark_threshold(cbar, field: RiskField) -> None:
@@ -232,8 +245,9 @@ def _panel_city_map(fig, ax, field, ports, section_y):
     low = field.band[0]
     if low < top:
         cbar.ax.axhline(low, color="black", lw=1.2)
-        cbar.ax.annotate(f"h_min {low:g} m", (0.5, low), xycoords=("axes fraction", "data"), xytext=(0, 2),
-                         textcoords="offset points", ha="center", va="bottom", fontsize=6.5, path_effects=HALO)
+        cbar.ax.annotate("h_min", (0.5, low), xycoords=("axes fraction", "data"), xytext=(0, 3),
+                         textcoords="offset points", ha="center", va="bottom", fontsize=6.5, rotation=90,
+                         path_effects=HALO)
     ax.legend(handles=[Patch(facecolor=ROAD, label="road"), Patch(facecolor=OPEN_SPACE, label="park / water"),
                        Patch(facecolor=GROUND, edgecolor="0.6", label="open ground"),
                        Patch(facecolor="none", edgecolor=NO_FLY, lw=1.2, label="no-fly")],
@@ -249,17 +263,19 @@ def _panel_section(fig, ax, field, j, norm, cmap, cruise_altitude_m):
     surface = city.surface_height[:, j]
     ax.fill_between(np.repeat(xe, 2)[1:-1], 0.0, np.repeat(surface, 2), color=BUILDING_GREY, lw=0, zorder=3)
     free_unsafe = field.unsafe[:, j, :] & ~field.obstacle[:, j, :]
-    ax.add_collection(LineCollection(_outline(free_unsafe, xe, ze), colors="black", linewidths=0.8, zorder=4))
+    # thinner outlines on finer grids, so a one-cell column keeps its colour
+    width = float(np.clip(60.0 / g.shape[0], 0.2, 0.8))
+    ax.add_collection(LineCollection(_outline(free_unsafe, xe, ze), colors="black", linewidths=width, zorder=4))
     # roads and no-fly columns on a strip below the ground line
     strip = -0.05 * zmax
     for mask, colour in ((city.road_length[:, j] > 0, ROAD), (city.no_fly[:, j], NO_FLY)):
         i = np.flatnonzero(mask)
         ax.hlines(np.full(i.size, 0.5 * strip), xe[i], xe[i + 1], colors=colour, lw=4, zorder=3)
     low, high = field.band
-    for level, label in ((low, "band low"), (high, "band high")):
+    for level, label, dy, va in ((low, "band low", 2, "bottom"), (high, "band high", -2, "top")):
         ax.axhline(level, color="#2ca02c", lw=1.2, ls="--", zorder=5)
-        ax.annotate(f"{label} {level:g} m", (g.extent[0], level), xytext=(-3, 2), textcoords="offset points",
-                    ha="right", fontsize=6.5, color="#1a6e1a", path_effects=HALO, zorder=6)
+        ax.annotate(f"{label} {level:g} m", (g.extent[0], level), xytext=(-3, dy), textcoords="offset points",
+                    ha="right", va=va, fontsize=6.5, color="#1a6e1a", path_effects=HALO, zorder=6)
     ax.axhline(cruise_altitude_m, color="black", lw=0.8, ls=":", zorder=5)
     ax.annotate(f"cruise {cruise_altitude_m:g} m", (0.0, cruise_altitude_m), xytext=(3, 2),
                 textcoords="offset points", fontsize=6.5, path_effects=HALO, zorder=6)
@@ -271,7 +287,7 @@ def _panel_section(fig, ax, field, j, norm, cmap, cruise_altitude_m):
     y0, y1 = j * g.cell[1], (j + 1) * g.cell[1]
     ax.set_title(f"(c) section at y = {y0:g}–{y1:g} m (row j={j}); outlined: unsafe free cells", fontsize=9,
                  loc="left")
-    cbar = fig.colorbar(mesh, ax=ax, pad=0.01, fraction=0.04)
+    cbar = fig.colorbar(mesh, cax=_colorbar_axes(ax, width=0.018, pad=0.012))
     _mark_threshold(cbar, field)
 
 
@@ -305,7 +321,7 @@ def _panel_profiles(ax, field: RiskField) -> None:
     ax.set_ylabel("altitude z (m)", fontsize=8)
     ax.tick_params(labelsize=7)
     ax.legend(fontsize=6.5, loc="best", framealpha=0.85)
-    ax.set_title("(d) risk terms per layer", fontsize=9, loc="left")
+    ax.set_title("(d) risk terms (unweighted)", fontsize=9, loc="left")
 
 
 def _panel_unsafe_share(ax, field: RiskField) -> None:
@@ -427,29 +443,34 @@ def plot_risk_components(field: RiskField, path: str | Path, *, title: str = "")
     """Vertical profiles of each term of Eq. 8 (R^P, R^V, R^U and R), one panel each.
 
     Each panel shows, per layer, the mean over the free cells (line) and the 10–90 % range of
-    the free cells (band), on a log axis with R_0 dashed and the altitude band of Eq. 14 shaded.
+    the free cells where the term is positive (band; R^V is zero off the roads, and the title
+    gives the share of free cells over a road), on a log axis with R_0 dashed and the altitude
+    band of Eq. 14 shaded.
     Writes a 12 × 4 in PNG at 130 dpi and returns ``path``.
     """
     path = Path(path)
     z = field.grid.z
     means = _layer_profiles(field)
     fig = Figure(figsize=(12.0, 4.0), dpi=DPI, layout="constrained")
+    fig.get_layout_engine().set(rect=(0.0, 0.03, 1.0, 0.97))
     axes = fig.subplots(1, 4, sharey=True)
+    free = ~field.obstacle
     for ax, name in zip(axes, ("risk_P", "risk_V", "risk_U", "risk")):
         label, colour = PROFILE_STYLE[name]
         values = getattr(field, name)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)
-            lo, hi = np.nanpercentile(values, [10, 90], axis=(0, 1))
+            lo, hi = np.nanpercentile(np.where(values > 0, values, np.nan), [10, 90], axis=(0, 1))
         positive = lambda a: np.where(a > 0, a, np.nan)  # noqa: E731 - log axis
-        ax.fill_betweenx(z, positive(lo), positive(hi), color=colour, alpha=0.2, lw=0, label="10–90 %")
+        ax.fill_betweenx(z, positive(lo), positive(hi), color=colour, alpha=0.2, lw=0, label="10–90 % (term > 0)")
         ax.plot(positive(means[name]), z, color=colour, lw=1.5, marker=".", label="mean")
         ax.set_xscale("log")
         ax.axvline(field.threshold, color=NO_FLY, lw=1.0, ls="--", label="R₀")
         ax.axhspan(*field.band, color="#2ca02c", alpha=0.08, lw=0)
-        ax.set_title(label, fontsize=9)
+        share = (values > 0).sum() / max(int(free.sum()), 1)
+        ax.set_title(label if share > 0.999 else f"{label} (> 0 in {share:.0%} of free cells)", fontsize=9)
         ax.set_xlabel("per flight hour", fontsize=8)
-        ax.tick_params(labelsize=7)
+        ax.tick_params(labelsize=7, which="both")
     axes[0].set_ylabel("altitude z (m)", fontsize=8)
     axes[0].set_ylim(0.0, field.grid.extent[2])
     axes[0].legend(fontsize=7)

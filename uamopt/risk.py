@@ -244,43 +244,47 @@ def risk_field(scenario: Scenario, grid: AirspaceGrid, city: CityLayers) -> Risk
     (False, True)
     """
     started = time.perf_counter()
-    r, c = scenario.risk, RiskConstants.from_scenario(scenario)
+    r, c, a = scenario.risk, RiskConstants.from_scenario(scenario), scenario.aircraft
     g, lam = r.gravity_mps2, r.failure_rate_per_h
-    zc = grid.z
-    surface = city.surface_height[:, :, None]
-    # h' per cell (MODEL_NOTES); an obstacle is any cell reaching below the surface.
-    height = zc[None, None, :] - surface
-    obstacle = (zc - 0.5 * grid.cell[2])[None, None, :] < surface - 1e-9
-    height = np.where(obstacle, np.nan, height)
-
-    # Ground personnel: R^P = λ ρ_P S_e P^P (Eqs. 1-3, A.1-A.3).
-    decay = np.exp(-2.0 * c.k_per_m * height)  # e^{-2kh'}, shared by A.3 and the fall time
-    with np.errstate(divide="ignore", invalid="ignore"):
-        log_speed_sq = math.log(g / c.k_per_m) + np.log1p(-decay)
-        log_energy = math.log(0.5 * c.mass_kg) + log_speed_sq
-        cs = city.shelter[:, :, None]
-        inv4cs = np.where(cs > 0, 1.0 / (4.0 * np.where(cs > 0, cs, 1.0)), np.inf)
-        term = (math.log(r.beta_j) - log_energy) * inv4cs
-    term = np.where(np.isnan(term) & ~obstacle, 0.0, term)  # c_s = 0 and E = β exactly
-    p_people = expit(-(0.5 * math.log(r.alpha_j / r.beta_j) + term))
-    risk_p = (lam * c.crash_area_m2) * city.population_density[:, :, None] * p_people
-
-    # Ground vehicles: R^V = λ ρ_V l_r P^V (Eqs. 4-5): constant up the column.
-    risk_v_col = lam * r.traffic_density_per_m * city.road_length * c.vehicle_collision_probability
-    risk_v = np.where(obstacle, np.nan, risk_v_col[:, :, None])
-
-    # UAVs: R^U = λ ρ_U e_w e_h (v_r' t + e_l) (A.4-A.5), t the fall time from h'.
-    with np.errstate(invalid="ignore"):
-        t_fall = (c.k_per_m * height + np.log1p(np.sqrt(1.0 - decay))) / math.sqrt(g * c.k_per_m)
-    a = scenario.aircraft
-    risk_u = (lam * r.uav_density_per_m3 * a.wingspan_m * a.height_m) * (
-        c.mean_relative_speed_mps * t_fall + a.fuselage_length_m
-    )
-
     w1, w2, w3 = r.weights
-    risk = w1 * risk_p + w2 * risk_v + w3 * risk_u  # Eq. 8
-    with np.errstate(invalid="ignore"):
-        unsafe = (risk > r.threshold) | obstacle | city.no_fly[:, :, None]  # Eq. 9
+    shape = grid.shape
+    risk, risk_p, risk_v, risk_u = (np.empty(shape) for _ in range(4))
+    unsafe = np.empty(shape, dtype=bool)
+    obstacle = np.empty(shape, dtype=bool)
+
+    # Column terms, computed once: N^P = ρ_P S_e (Eq. 2), 1/(4 c_s) (Eq. 3, inf where c_s = 0),
+    # and R^V = λ ρ_V l_r P^V (Eqs. 4-5), which does not depend on altitude.
+    people_per_crash = c.crash_area_m2 * city.population_density
+    with np.errstate(divide="ignore"):
+        inv4cs = np.where(city.shelter > 0, 1.0 / (4.0 * np.where(city.shelter > 0, city.shelter, 1.0)), np.inf)
+    risk_v_col = lam * r.traffic_density_per_m * city.road_length * c.vehicle_collision_probability
+    half_log_ab = 0.5 * math.log(r.alpha_j / r.beta_j)
+    log_half_m_g_over_k = math.log(0.5 * c.mass_kg * g / c.k_per_m)
+    uav_scale = lam * r.uav_density_per_m3 * a.wingspan_m * a.height_m
+    root_gk = math.sqrt(g * c.k_per_m)
+
+    # One layer at a time: every operation is vectorised over the layer's columns, and the
+    # temporaries stay the size of one layer (memory ~ outputs only, even at 5 m cells).
+    for k, z in enumerate(grid.z):
+        # h' per cell (MODEL_NOTES); an obstacle is any cell reaching below the surface.
+        blocked = (z - 0.5 * grid.cell[2]) < city.surface_height - 1e-9
+        height = np.where(blocked, np.nan, z - city.surface_height)
+        decay = np.exp(-2.0 * c.k_per_m * height)  # e^{-2kh'}, shared by A.3 and the fall time
+        with np.errstate(divide="ignore", invalid="ignore"):
+            # ln E_imp = ln(½ m g / k) + ln(1 - e^{-2kh'})  (A.1, A.3)
+            log_ratio = (math.log(r.beta_j) - log_half_m_g_over_k - np.log1p(-decay)) * inv4cs
+        log_ratio = np.where(np.isnan(log_ratio) & ~blocked, 0.0, log_ratio)  # c_s = 0 and E = β
+        p_people = expit(-(half_log_ab + log_ratio))  # Eq. 3
+        risk_p[:, :, k] = lam * people_per_crash * p_people  # Eq. 1
+        risk_v[:, :, k] = np.where(blocked, np.nan, risk_v_col)
+        with np.errstate(invalid="ignore"):
+            t_fall = (c.k_per_m * height + np.log1p(np.sqrt(1.0 - decay))) / root_gk
+        risk_u[:, :, k] = uav_scale * (c.mean_relative_speed_mps * t_fall + a.fuselage_length_m)  # A.4-A.5
+        layer = w1 * risk_p[:, :, k] + w2 * risk_v[:, :, k] + w3 * risk_u[:, :, k]  # Eq. 8
+        risk[:, :, k] = layer
+        with np.errstate(invalid="ignore"):
+            unsafe[:, :, k] = (layer > r.threshold) | blocked | city.no_fly  # Eq. 9
+        obstacle[:, :, k] = blocked
     return RiskField(
         grid=grid, city=city, risk=risk, risk_P=risk_p, risk_V=risk_v, risk_U=risk_u,
         unsafe=unsafe, obstacle=obstacle, band=altitude_band(scenario), constants=c,
