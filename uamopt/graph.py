@@ -46,6 +46,24 @@ def neighbour_moves(passable: np.ndarray, offset: tuple[int, int, int]) -> np.nd
     return ok
 
 
+def grid_graph(passable: np.ndarray, cell: tuple[float, float, float], *, neighbourhood: int = 26) -> nx.Graph:
+    """Undirected graph of the ``passable`` cells (bool (nx, ny, nz)): node (i, j, k), edges between
+    neighbours whose move keeps clear of impassable corners, edge attribute ``length`` (m)."""
+    if neighbourhood not in (6, 18, 26):
+        raise ValueError(f"neighbourhood must be 6, 18 or 26, got {neighbourhood}")
+    graph = nx.Graph(cell=tuple(cell), shape=passable.shape)
+    graph.add_nodes_from(map(tuple, np.argwhere(passable).tolist()))
+    reach = {6: 1, 18: 2, 26: 3}[neighbourhood]
+    for offset in HALF_NEIGHBOURHOOD:
+        if sum(map(abs, offset)) > reach:
+            continue
+        src = np.argwhere(neighbour_moves(passable, offset))
+        dst = src + np.asarray(offset)
+        length = float(np.linalg.norm(np.asarray(offset) * np.asarray(cell, dtype=float)))
+        graph.add_edges_from(zip(map(tuple, src.tolist()), map(tuple, dst.tolist())), length=length)
+    return graph
+
+
 def to_networkx(field: RiskField, *, neighbourhood: int = 26) -> nx.Graph:
     """The passable airspace as an undirected :class:`networkx.Graph`.
 
@@ -71,27 +89,13 @@ def to_networkx(field: RiskField, *, neighbourhood: int = 26) -> nx.Graph:
     >>> G.number_of_nodes() == int((~(f.obstacle | f.no_fly)).sum())
     True
     """
-    if neighbourhood not in (6, 18, 26):
-        raise ValueError(f"neighbourhood must be 6, 18 or 26, got {neighbourhood}")
     passable = passable_cells(field)
-    cell = np.asarray(field.grid.cell)
-    grid = field.grid
-    graph = nx.Graph(cell=tuple(cell), shape=grid.shape)
+    graph = grid_graph(passable, field.grid.cell, neighbourhood=neighbourhood)
     idx = np.argwhere(passable)
-    centres = (idx + 0.5) * cell
-    risk = field.risk[passable]
-    unsafe = field.unsafe[passable]
-    graph.add_nodes_from(
-        (tuple(map(int, c)), {"pos": tuple(map(float, p)), "risk": float(r), "unsafe": bool(u)})
-        for c, p, r, u in zip(idx, centres, risk, unsafe)
-    )
-    for offset in HALF_NEIGHBOURHOOD:
-        if sum(map(abs, offset)) > {6: 1, 18: 2, 26: 3}[neighbourhood]:
-            continue
-        src = np.argwhere(neighbour_moves(passable, offset))
-        dst = src + np.asarray(offset)
-        length = float(np.linalg.norm(np.asarray(offset) * cell))
-        graph.add_edges_from(
-            ((tuple(map(int, a)), tuple(map(int, b))) for a, b in zip(src, dst)), length=length
-        )
+    centres = (idx + 0.5) * np.asarray(field.grid.cell)
+    attrs = {
+        (int(i), int(j), int(k)): {"pos": tuple(map(float, p)), "risk": float(r), "unsafe": bool(u)}
+        for (i, j, k), p, r, u in zip(idx, centres, field.risk[passable], field.unsafe[passable])
+    }
+    nx.set_node_attributes(graph, attrs)
     return graph

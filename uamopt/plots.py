@@ -30,8 +30,8 @@ import numpy as np
 from matplotlib import colors, patheffects
 from matplotlib.collections import LineCollection, PolyCollection
 from matplotlib.figure import Figure
-from matplotlib.patches import Patch
 from matplotlib.lines import Line2D
+from matplotlib.patches import Patch
 
 from uamopt.risk import RiskField
 
@@ -46,6 +46,16 @@ OPEN_SPACE = "#b9dba0"  # parks and water
 ROAD = "#8c8c8c"
 NO_FLY = "#d62728"
 HALO = [patheffects.withStroke(linewidth=2.5, foreground="white")]
+ROAD_OUTLINE_MAX_COLUMNS = 120  # columns across map (a) up to which road columns are outlined
+# legends below the map, clear of its tick labels and x label (borderaxespad is in font sizes)
+LEGEND_BELOW = {"loc": "upper center", "bbox_to_anchor": (0.5, 0.0), "borderaxespad": 3.4, "ncol": 2,
+                "fontsize": 7, "frameon": False}
+PROFILE_STYLE = {  # risk term: (label, colour)
+    "risk": ("R (Eq. 8)", "black"),
+    "risk_P": ("R^P people", "#1f77b4"),
+    "risk_V": ("R^V vehicles", "#ff7f0e"),
+    "risk_U": ("R^U UAVs", "#9467bd"),
+}
 
 
 # --- small vectorised helpers ----------------------------------------------------------------
@@ -71,6 +81,11 @@ def _log10(values: np.ndarray) -> np.ndarray:
     with np.errstate(divide="ignore", invalid="ignore"):
         out = np.log10(values)
     return np.where(np.isfinite(out), out, np.nan)
+
+
+def _positive(values: np.ndarray) -> np.ndarray:
+    """NaN where not > 0, so a log axis leaves a gap instead of warning."""
+    return np.where(values > 0, values, np.nan)
 
 
 def _outline(mask: np.ndarray, xe: np.ndarray, ye: np.ndarray) -> np.ndarray:
@@ -112,11 +127,6 @@ def _height_cmap() -> colors.ListedColormap:
     return colors.ListedColormap(matplotlib.colormaps["magma_r"](np.linspace(0.22, 1.0, 256)), name="heights")
 
 
-ROAD_OUTLINE_MAX_COLUMNS = 120  # columns across map (a) up to which road columns are outlined
-# below the axes, clear of tick labels and x label (borderaxespad is in font sizes)
-LEGEND_BELOW = dict(loc="upper center", bbox_to_anchor=(0.5, 0.0), borderaxespad=3.4, ncol=2, fontsize=7,
-                    frameon=False)
-
 
 def _vertiport_points(vertiports: Iterable) -> list[tuple[str, float, float]]:
     """(name, x, y) from Vertiport objects, mappings or (name, x, y) tuples."""
@@ -144,10 +154,21 @@ def _default_section_y(field: RiskField, ports: list[tuple[str, float, float]]) 
 
 
 def _attribution(field: RiskField) -> str:
+    """The city's attribution; OpenStreetMap data is always credited (ODbL)."""
     text = field.city.attribution or ""
     if field.city.source == "osm" and "OpenStreetMap" not in text:
         text = f"{OSM_CREDIT}. {text}".strip(". ")
     return text
+
+
+def _finish(fig: Figure, field: RiskField, path: Path) -> Path:
+    """Credit the data in the bottom-right corner, write the PNG, free the figure."""
+    credit = _attribution(field)
+    if credit:
+        fig.text(0.995, 0.002, credit, ha="right", va="bottom", fontsize=7, color="0.25")
+    fig.savefig(path, dpi=DPI)
+    fig.clear()
+    return path
 
 
 # --- panels ------------------------------------------------------------------------------------
@@ -196,8 +217,9 @@ def _panel_risk_map(fig, ax, field, k, norm, cmap, ports, section_y):
         ax.add_collection(LineCollection(_outline(city.road_length > 0, xe, ye), colors="white",
                                          linewidths=0.35, alpha=0.7))
     if city.no_fly.any():
-        ax.add_collection(PolyCollection(_runs(city.no_fly, xe, ye), facecolors="none", edgecolors="none",
-                                         hatch="////", hatchcolor=NO_FLY, zorder=4))
+        # the hatch takes the edge colour; zero width keeps the run borders invisible
+        ax.add_collection(PolyCollection(_runs(city.no_fly, xe, ye), facecolors="none", edgecolors=NO_FLY,
+                                         linewidths=0.0, hatch="////", zorder=4))
         ax.add_collection(LineCollection(_outline(city.no_fly, xe, ye), colors=NO_FLY, linewidths=1.2, zorder=4))
     _map_axes(ax, field)
     _draw_section_line(ax, section_y, g.extent[0])
@@ -299,19 +321,12 @@ def _layer_profiles(field: RiskField) -> dict[str, np.ndarray]:
                 for name in ("risk", "risk_P", "risk_V", "risk_U")}
 
 
-PROFILE_STYLE = {
-    "risk": ("R (Eq. 8)", "black"),
-    "risk_P": ("R^P people", "#1f77b4"),
-    "risk_V": ("R^V vehicles", "#ff7f0e"),
-    "risk_U": ("R^U UAVs", "#9467bd"),
-}
-
 
 def _panel_profiles(ax, field: RiskField) -> None:
     z = field.grid.z
     for name, values in _layer_profiles(field).items():
         label, colour = PROFILE_STYLE[name]
-        ax.plot(np.where(values > 0, values, np.nan), z, color=colour, lw=1.6 if name == "risk" else 1.1,
+        ax.plot(_positive(values), z, color=colour, lw=1.6 if name == "risk" else 1.1,
                 label=label, marker=".", ms=3)
     ax.set_xscale("log")
     ax.axvline(field.threshold, color="0.45", lw=1.0, ls="--", label="R₀")
@@ -382,14 +397,11 @@ def plot_risk(
     Path
         ``path``.
 
-    Examples
-    --------
-    >>> import tempfile, pathlib
-    >>> from uamopt import load_scenario, build_grid, load_city, risk_field
-    >>> s = load_scenario("models/paper_case.toml")  # doctest: +SKIP
-    >>> g = build_grid(s); f = risk_field(s, g, load_city(s, g))  # doctest: +SKIP
-    >>> plot_risk(f, "risk.png", vertiports=s.network.vertiports)  # doctest: +SKIP
-    PosixPath('risk.png')
+    Notes
+    -----
+    Used as ``plot_risk(field, out / "risk.png", vertiports=scenario.network.vertiports,
+    cruise_altitude_m=scenario.network.cruise_altitude_m, title=scenario.name)``; see
+    ``notebooks/01_risk_field.ipynb`` and ``tests/test_plots.py``.
     """
     path = Path(path)
     g = field.grid
@@ -431,12 +443,7 @@ def plot_risk(
         f"buildings, no-fly): {field.unsafe.mean():.1%} of cells{band_text}",
         fontsize=10.5,
     )
-    credit = _attribution(field)
-    if credit:
-        fig.text(0.995, 0.002, credit, ha="right", va="bottom", fontsize=7, color="0.25")
-    fig.savefig(path, dpi=DPI)
-    fig.clear()
-    return path
+    return _finish(fig, field, path)
 
 
 def plot_risk_components(field: RiskField, path: str | Path, *, title: str = "") -> Path:
@@ -460,10 +467,10 @@ def plot_risk_components(field: RiskField, path: str | Path, *, title: str = "")
         values = getattr(field, name)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)
-            lo, hi = np.nanpercentile(np.where(values > 0, values, np.nan), [10, 90], axis=(0, 1))
-        positive = lambda a: np.where(a > 0, a, np.nan)  # noqa: E731 - log axis
-        ax.fill_betweenx(z, positive(lo), positive(hi), color=colour, alpha=0.2, lw=0, label="10–90 % (term > 0)")
-        ax.plot(positive(means[name]), z, color=colour, lw=1.5, marker=".", label="mean")
+            lo, hi = np.nanpercentile(_positive(values), [10, 90], axis=(0, 1))
+        ax.fill_betweenx(z, _positive(lo), _positive(hi), color=colour, alpha=0.2, lw=0,
+                         label="10–90 % (term > 0)")
+        ax.plot(_positive(means[name]), z, color=colour, lw=1.5, marker=".", label="mean")
         ax.set_xscale("log")
         ax.axvline(field.threshold, color=NO_FLY, lw=1.0, ls="--", label="R₀")
         ax.axhspan(*field.band, color="#2ca02c", alpha=0.08, lw=0)
@@ -477,9 +484,4 @@ def plot_risk_components(field: RiskField, path: str | Path, *, title: str = "")
     g = field.grid
     fig.suptitle(f"{title + ' — ' if title else ''}risk terms over the free cells of each layer "
                  f"(cells {g.cell[0]:g} × {g.cell[1]:g} × {g.cell[2]:g} m)", fontsize=10)
-    credit = _attribution(field)
-    if credit:
-        fig.text(0.995, 0.003, credit, ha="right", va="bottom", fontsize=6.5, color="0.25")
-    fig.savefig(path, dpi=DPI)
-    fig.clear()
-    return path
+    return _finish(fig, field, path)

@@ -174,6 +174,21 @@ class TracksConfig(_Section):
     clearance_m: NonNegFloat = Field(50.0, description="s_min, building clearance, m (Eq. 15)")
     buffer_penalty: NonNegFloat = Field(100.0, description="μ, safety-buffer shell penalty (Eq. 35)")
     risk_model: Literal["binary", "continuous"] = Field("binary", description="Eq. 9 field or Eq. 8 field")
+    wind_speed_mps: NonNegFloat = Field(0.0, description="v_wr, actual wind, m/s; must not exceed v_we (Eq. 19)")
+    search: Literal["fast", "python", "networkx"] = Field("fast", description="search backend")
+    heuristic: Literal["transport", "zero"] = Field(
+        "transport", description="A* heuristic: cheapest transport cost to the goal, or 0 (the paper's)"
+    )
+    equivalent: Literal["exact", "exact_cost", "midpoint"] = Field(
+        "exact", description="equivalent track: exact shortest polyline in the corridor (SOCP), the corridor's "
+        "exact Eq. 10 optimum (SOCP), or the paper's midpoint rule"
+    )
+    smoothing_m: NonNegFloat = Field(
+        10.0, description="largest mean deviation of the smoothing spline from the equivalent track, m"
+    )
+    layering: Literal["direction", "none"] = Field(
+        "direction", description="network: the two directions of a route on separate cruise layers (Sec. 4.1.2)"
+    )
 
 
 class ScheduleConfig(_Section):

@@ -15,6 +15,7 @@ import shapely
 from affine import Affine
 from rasterio import features
 
+from uamopt.geometry import split_segments
 from uamopt.grid import AirspaceGrid
 from uamopt.scenario import CityConfig
 
@@ -130,40 +131,15 @@ def segment_length_per_cell(segments: np.ndarray, grid: AirspaceGrid) -> np.ndar
     Vectorised over segments and crossings: no Python loop over cells.
     """
     nx, ny = grid.shape[:2]
-    dx, dy = grid.cell[:2]
     seg = np.asarray(segments, dtype=float).reshape(-1, 4)
-    seg = seg[np.hypot(seg[:, 2] - seg[:, 0], seg[:, 3] - seg[:, 1]) > 0]
     if len(seg) == 0:
         return np.zeros((nx, ny))
-    x0, y0, x1, y1 = seg.T
-    ts = [np.zeros(len(seg)), np.ones(len(seg))]
-    owners = [np.arange(len(seg)), np.arange(len(seg))]
-    for a0, a1, step in ((x0, x1, dx), (y0, y1, dy)):
-        lo = np.ceil(np.minimum(a0, a1) / step).astype(np.int64)
-        hi = np.floor(np.maximum(a0, a1) / step).astype(np.int64)
-        count = np.maximum(hi - lo + 1, 0)
-        moving = a1 != a0
-        count = np.where(moving, count, 0)
-        owner = np.repeat(np.arange(len(seg)), count)
-        offset = np.arange(count.sum()) - np.repeat(np.cumsum(count) - count, count)
-        line = (np.repeat(lo, count) + offset) * step
-        t = (line - a0[owner]) / (a1[owner] - a0[owner])
-        ts.append(t)
-        owners.append(owner)
-    t = np.clip(np.concatenate(ts), 0.0, 1.0)
-    owner = np.concatenate(owners)
-    order = np.lexsort((t, owner))
-    t, owner = t[order], owner[order]
-    same = owner[1:] == owner[:-1]
-    t_a, t_b, who = t[:-1][same], t[1:][same], owner[:-1][same]
-    keep = t_b > t_a
-    t_a, t_b, who = t_a[keep], t_b[keep], who[keep]
-    tm = 0.5 * (t_a + t_b)
-    xm = x0[who] + tm * (x1[who] - x0[who])
-    ym = y0[who] + tm * (y1[who] - y0[who])
-    length = (t_b - t_a) * np.hypot(x1 - x0, y1 - y0)[who]
-    i = np.floor(xm / dx).astype(np.int64)
-    j = np.floor(ym / dy).astype(np.int64)
+    starts, ends = seg[:, :2], seg[:, 2:]
+    owner, t0, t1 = split_segments(starts, ends, grid.cell[:2])
+    mid = starts[owner] + (0.5 * (t0 + t1))[:, None] * (ends[owner] - starts[owner])
+    length = (t1 - t0) * np.linalg.norm(ends - starts, axis=1)[owner]
+    i = np.floor(mid[:, 0] / grid.cell[0]).astype(np.int64)
+    j = np.floor(mid[:, 1] / grid.cell[1]).astype(np.int64)
     inside = (i >= 0) & (i < nx) & (j >= 0) & (j < ny)
     flat = np.bincount(i[inside] * ny + j[inside], weights=length[inside], minlength=nx * ny)
     return flat.reshape(nx, ny)

@@ -1,0 +1,144 @@
+"""The single-aircraft track planning model (Sec. 4.2, 5.1): admissible cells, costs, buffer.
+
+Readings (MODEL_NOTES, paper Sec. 5.1):
+
+- Admissible cells: passable (not an obstacle, not a no-fly zone; Eq. 9/15), centre altitude in
+  the band of Eq. 14, and centre at least s_min from the centre of every obstacle cell (Eq. 15).
+  A continuous track is admissible when every point of it lies in admissible cells.
+- Safety buffer (Eqs. 34–35): a box of n_s cells per axis around the cell entered,
+  n_s = ⌈s_min/Δ⌉·2 + 1 (50 m cells → 3, 30 m layers → 5); R(t) counts the unsafe cells (Eq. 9:
+  risky, obstacle or no-fly) on the box's outer shell; the move pays μ·R(t). Cells outside the
+  grid count as safe. Computed for all cells at once with a 3-D summed-area table.
+- Transport cost (Eqs. 12–13): c_h·horizontal + c_v·|vertical| times c_e·τ(m_p),
+  τ = 1 + (m_p/m_p,max)·τ_max.
+- Risk cost (Eq. 11) uses the binary field of Eq. 9 by default (``tracks.risk_model``), the
+  continuous Eq. 8 field as a variant.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import ndimage
+
+from uamopt.errors import UamoptError
+from uamopt.planning.search import SearchProblem
+from uamopt.risk import RiskField
+from uamopt.scenario import Scenario
+
+
+def load_factor(scenario: Scenario) -> float:
+    """τ(m_p) = 1 + (m_p / m_p,max) τ_max (Eq. 13)."""
+    a = scenario.aircraft
+    return 1.0 + a.payload_kg / a.payload_max_kg * a.tau_max
+
+
+def transport_rates(scenario: Scenario) -> tuple[float, float]:
+    """(c_h c_e τ, c_v c_e τ): ¥ per horizontal and per vertical metre (Eq. 12), before ω5."""
+    a = scenario.aircraft
+    tau = load_factor(scenario)
+    return a.c_h * a.c_e * tau, a.c_v * a.c_e * tau
+
+
+def buffer_cells(cell: tuple[float, float, float], clearance_m: float) -> tuple[int, int, int]:
+    """n_s per axis: ⌈s_min / Δ⌉ · 2 + 1 (Sec. 5.1)."""
+    return tuple(int(math.ceil(clearance_m / d - 1e-9)) * 2 + 1 for d in cell)  # type: ignore[return-value]
+
+
+def box_counts(mask: np.ndarray, half: tuple[int, int, int]) -> np.ndarray:
+    """Number of True cells in the box of half-widths ``half`` centred on every cell (int32);
+    cells beyond the grid count as False. A summed-area table: O(cells), no loop over cells."""
+    hx, hy, hz = half
+    sat = np.zeros(tuple(n + 1 for n in mask.shape), dtype=np.int32)
+    sat[1:, 1:, 1:] = mask.astype(np.int32).cumsum(0).cumsum(1).cumsum(2)
+    nx, ny, nz = mask.shape
+    lo = [np.clip(np.arange(n) - h, 0, n) for n, h in zip(mask.shape, half)]
+    hi = [np.clip(np.arange(n) + h + 1, 0, n) for n, h in zip(mask.shape, half)]
+    x0, x1 = lo[0][:, None, None], hi[0][:, None, None]
+    y0, y1 = lo[1][None, :, None], hi[1][None, :, None]
+    z0, z1 = lo[2][None, None, :], hi[2][None, None, :]
+    return (sat[x1, y1, z1] - sat[x0, y1, z1] - sat[x1, y0, z1] - sat[x1, y1, z0]
+            + sat[x0, y0, z1] + sat[x0, y1, z0] + sat[x1, y0, z0] - sat[x0, y0, z0])
+
+
+def buffer_shell_count(unsafe: np.ndarray, n_s: tuple[int, int, int]) -> np.ndarray:
+    """R(t) of Eq. 35 for every cell: unsafe cells on the outer shell of its n_s box."""
+    outer = tuple((n - 1) // 2 for n in n_s)
+    inner = tuple(h - 1 for h in outer)
+    full = box_counts(unsafe, outer)
+    if min(inner) < 0:
+        return full
+    return full - box_counts(unsafe, inner)  # type: ignore[arg-type]
+
+
+def clearance_ok(obstacle: np.ndarray, cell: tuple[float, float, float], clearance_m: float) -> np.ndarray:
+    """Cells whose centre is at least s_min from the centre of every obstacle cell (Eq. 15)."""
+    if clearance_m <= 0 or not obstacle.any():
+        return np.ones(obstacle.shape, dtype=bool)
+    if obstacle.all():
+        return np.zeros(obstacle.shape, dtype=bool)
+    distance = ndimage.distance_transform_edt(~obstacle, sampling=cell)
+    return distance >= clearance_m - 1e-9
+
+
+@dataclass(frozen=True)
+class PlanningModel:
+    """Everything the planner's stages need, derived once from the scenario and the risk field."""
+
+    scenario: Scenario
+    field: RiskField
+    admissible: np.ndarray  # bool (nx, ny, nz)
+    risk: np.ndarray  # R used in Eq. 11 (binary or continuous), 0 in inadmissible cells
+    shell_count: np.ndarray  # R(t) of Eq. 35 (int)
+    n_s: tuple[int, int, int]
+    c_h: float  # c_h c_e τ, ¥/m
+    c_v: float  # c_v c_e τ, ¥/m
+
+    def search_problem(self, stage: str) -> SearchProblem:
+        """``shortest``: transport cost only (standard A*); ``initial``: Eqs. 10–13 plus μ·R(t)."""
+        w_risk, w_transport = self.scenario.tracks.weights
+        if stage == "shortest":
+            zero = np.zeros(self.admissible.shape)
+            return SearchProblem(self.admissible, zero, zero, self.field.grid.cell, 0.0, self.c_h, self.c_v)
+        if stage != "initial":
+            raise ValueError(f"stage must be 'shortest' or 'initial', got {stage!r}")
+        penalty = self.scenario.tracks.buffer_penalty * self.shell_count
+        return SearchProblem(self.admissible, self.risk, penalty, self.field.grid.cell, w_risk,
+                             w_transport * self.c_h, w_transport * self.c_v)
+
+
+def check_aircraft_limits(scenario: Scenario) -> None:
+    """Eqs. 18–19: take-off mass and wind within the aircraft's limits."""
+    a, t = scenario.aircraft, scenario.tracks
+    if a.empty_mass_kg + a.payload_max_kg > a.mass_max_kg:
+        raise UamoptError(
+            f"take-off mass m_e + m_p,max = {a.empty_mass_kg + a.payload_max_kg:g} kg exceeds m_max = {a.mass_max_kg:g} kg",
+            "aircraft (Eq. 18)", "lower aircraft.payload_max_kg or raise aircraft.mass_max_kg")
+    if a.payload_kg > a.payload_max_kg:
+        raise UamoptError(f"payload m_p = {a.payload_kg:g} kg exceeds m_p,max = {a.payload_max_kg:g} kg",
+                          "aircraft.payload_kg (Eq. 13)", "lower the payload")
+    if t.wind_speed_mps > a.wind_max_mps:
+        raise UamoptError(f"wind {t.wind_speed_mps:g} m/s exceeds the aircraft's limit v_we = {a.wind_max_mps:g} m/s",
+                          "tracks.wind_speed_mps (Eq. 19)", "plan for a calmer wind or another aircraft")
+
+
+def planning_model(scenario: Scenario, field: RiskField) -> PlanningModel:
+    """Admissible cells, Eq. 11 risk, the buffer's shell counts and transport rates."""
+    check_aircraft_limits(scenario)
+    grid = field.grid
+    s_min = scenario.tracks.clearance_m
+    in_band = np.zeros(grid.shape[2], dtype=bool)
+    in_band[field.band_layers()] = True
+    admissible = ~(field.obstacle | field.no_fly) & in_band[None, None, :]
+    admissible &= clearance_ok(field.obstacle, grid.cell, s_min)
+    if scenario.tracks.risk_model == "binary":
+        risk = field.unsafe.astype(float)
+    else:
+        risk = np.nan_to_num(field.risk, nan=0.0)
+    risk = np.where(admissible, risk, 0.0)
+    n_s = buffer_cells(grid.cell, s_min)
+    shell = buffer_shell_count(field.unsafe, n_s)
+    c_h, c_v = transport_rates(scenario)
+    return PlanningModel(scenario, field, admissible, risk, shell, n_s, c_h, c_v)

@@ -1,0 +1,346 @@
+"""Optimal grid search for the track planner: four backends that must agree on the optimal cost.
+
+The move n → m between 26-neighbour cells (MODEL_NOTES) costs
+
+    w_risk · ½(R_n + R_m) · d  +  c_h' · horizontal  +  c_v' · |vertical|  +  penalty_m
+
+where d is the centre distance, c_h' = ω5 c_h c_e τ(m_p) and c_v' = ω5 c_v c_e τ(m_p) fold Eq. 12's
+constants, w_risk = ω4 (Eqs. 10–11) and penalty_m = μ·R(t_m) is the safety-buffer term (Eq. 35).
+A move may not cut the corner of an impassable cell: every cell of its bounding box must be
+passable.
+
+Backends (``backend=``):
+
+- ``"fast"`` (default): A* compiled with numba over the implicit grid (flat arrays; no Python
+  object per cell or edge).
+- ``"python"``: the same A* in pure Python with ``heapq`` — the paper's algorithm, as a readable
+  reference.
+- ``"networkx"``: ``networkx.astar_path`` on the explicit grid graph with the same weights.
+
+Heuristics (``heuristic=``): ``"zero"`` (the paper's A*, i.e. Dijkstra) or ``"transport"``, the
+cheapest possible transport cost to the goal, c_h'·octile(Δi Δx, Δj Δy) + c_v'·|Δk| Δz. It is a
+lower bound of every path's cost (risk and penalty terms are ≥ 0; horizontal and vertical parts of
+the moves are independent) and consistent, so A* with it returns the same optimal cost with far
+fewer expansions.
+"""
+
+from __future__ import annotations
+
+import heapq
+import itertools
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
+
+from uamopt.errors import NoTrackError
+
+
+@dataclass(frozen=True)
+class SearchProblem:
+    """A grid search instance. Arrays have shape (nx, ny, nz); costs as in the module docstring."""
+
+    passable: np.ndarray  # bool
+    risk: np.ndarray  # float, R of Eq. 11 per cell (0 where unused)
+    penalty: np.ndarray  # float, μ·R(t) charged on entering a cell
+    cell: tuple[float, float, float]
+    w_risk: float  # ω4
+    c_h: float  # ω5 · c_h · c_e · τ, ¥ per horizontal metre (or 1 for plain distance)
+    c_v: float  # ω5 · c_v · c_e · τ, ¥ per vertical metre
+
+    @property
+    def shape(self) -> tuple[int, int, int]:
+        return self.passable.shape  # type: ignore[return-value]
+
+
+@dataclass(frozen=True)
+class SearchResult:
+    """An optimal path of cells (n, 3), its cost, the number of expanded cells and the time."""
+
+    path: np.ndarray
+    cost: float
+    expansions: int
+    seconds: float
+    backend: str
+    heuristic: str
+
+
+OFFSETS = np.array([d for d in itertools.product((-1, 0, 1), repeat=3) if d != (0, 0, 0)], dtype=np.int64)
+
+
+def _corner_table() -> tuple[np.ndarray, np.ndarray]:
+    """For each of the 26 offsets, the cells of its bounding box other than the source."""
+    corners = np.zeros((26, 7, 3), dtype=np.int64)
+    counts = np.zeros(26, dtype=np.int64)
+    for n, d in enumerate(OFFSETS):
+        box = [c for c in itertools.product(*[(0, int(o)) if o else (0,) for o in d]) if any(c)]
+        counts[n] = len(box)
+        corners[n, : len(box)] = box
+    return corners, counts
+
+
+CORNERS, CORNER_COUNTS = _corner_table()
+
+
+def move_costs(cell: tuple[float, float, float], c_h: float, c_v: float) -> tuple[np.ndarray, np.ndarray]:
+    """Per offset: centre distance d and transport cost c_h'·horizontal + c_v'·|vertical|."""
+    step = OFFSETS * np.asarray(cell, dtype=float)
+    length = np.linalg.norm(step, axis=1)
+    transport = c_h * np.hypot(step[:, 0], step[:, 1]) + c_v * np.abs(step[:, 2])
+    return length, transport
+
+
+def transport_lower_bound(a: tuple[int, int, int], b: tuple[int, int, int], cell, c_h: float, c_v: float) -> float:
+    """Cheapest transport cost from cell a to cell b over 26-neighbour moves (the heuristic)."""
+    di, dj, dk = (abs(int(x) - int(y)) for x, y in zip(a, b))
+    dx, dy, dz = cell
+    m = min(di, dj)
+    octile = m * math.hypot(dx, dy) + (di - m) * dx + (dj - m) * dy
+    return c_h * octile + c_v * dk * dz
+
+
+# --- fast backend: numba ----------------------------------------------------------------------
+
+
+@njit(cache=True)
+def _heap_push(keys, nodes, size, key, node):
+    if size == keys.shape[0]:
+        new_keys = np.empty(2 * size, dtype=keys.dtype)
+        new_nodes = np.empty(2 * size, dtype=nodes.dtype)
+        new_keys[:size] = keys
+        new_nodes[:size] = nodes
+        keys, nodes = new_keys, new_nodes
+    i = size
+    keys[i] = key
+    nodes[i] = node
+    while i > 0:
+        p = (i - 1) >> 1
+        if keys[p] > keys[i] or (keys[p] == keys[i] and nodes[p] > nodes[i]):
+            keys[p], keys[i] = keys[i], keys[p]
+            nodes[p], nodes[i] = nodes[i], nodes[p]
+            i = p
+        else:
+            break
+    return keys, nodes, size + 1
+
+
+@njit(cache=True)
+def _heap_pop(keys, nodes, size):
+    key, node = keys[0], nodes[0]
+    size -= 1
+    keys[0], nodes[0] = keys[size], nodes[size]
+    i = 0
+    while True:
+        left = 2 * i + 1
+        if left >= size:
+            break
+        c = left
+        right = left + 1
+        if right < size and (keys[right] < keys[left] or (keys[right] == keys[left] and nodes[right] < nodes[left])):
+            c = right
+        if keys[c] < keys[i] or (keys[c] == keys[i] and nodes[c] < nodes[i]):
+            keys[c], keys[i] = keys[i], keys[c]
+            nodes[c], nodes[i] = nodes[i], nodes[c]
+            i = c
+        else:
+            break
+    return key, node, size
+
+
+@njit(cache=True)
+def _astar_numba(passable, risk, penalty, nx, ny, nz, dx, dy, dz, w_risk, c_h, c_v,
+                 start, goal, use_heuristic, offsets, corners, counts, lengths, transports):
+    n_cells = nx * ny * nz
+    g = np.full(n_cells, np.inf)
+    parent = np.full(n_cells, -1, dtype=np.int64)
+    closed = np.zeros(n_cells, dtype=np.bool_)
+    keys = np.empty(1024, dtype=np.float64)
+    nodes = np.empty(1024, dtype=np.int64)
+    size = 0
+    gi, gj, gk = goal // (ny * nz), (goal // nz) % ny, goal % nz
+    diag = math.sqrt(dx * dx + dy * dy)
+    g[start] = 0.0
+    keys, nodes, size = _heap_push(keys, nodes, size, 0.0, start)
+    expansions = 0
+    while size > 0:
+        f, u, size = _heap_pop(keys, nodes, size)
+        if closed[u]:
+            continue
+        closed[u] = True
+        expansions += 1
+        if u == goal:
+            break
+        ui, uj, uk = u // (ny * nz), (u // nz) % ny, u % nz
+        gu = g[u]
+        for n in range(26):
+            vi, vj, vk = ui + offsets[n, 0], uj + offsets[n, 1], uk + offsets[n, 2]
+            if vi < 0 or vi >= nx or vj < 0 or vj >= ny or vk < 0 or vk >= nz:
+                continue
+            ok = True
+            for c in range(counts[n]):
+                ci, cj, ck = ui + corners[n, c, 0], uj + corners[n, c, 1], uk + corners[n, c, 2]
+                if not passable[(ci * ny + cj) * nz + ck]:
+                    ok = False
+                    break
+            if not ok:
+                continue
+            v = (vi * ny + vj) * nz + vk
+            if closed[v]:
+                continue
+            cand = gu + w_risk * 0.5 * (risk[u] + risk[v]) * lengths[n] + transports[n] + penalty[v]
+            if cand < g[v]:
+                g[v] = cand
+                parent[v] = u
+                h = 0.0
+                if use_heuristic:
+                    ai, aj = abs(vi - gi), abs(vj - gj)
+                    m = min(ai, aj)
+                    h = c_h * (m * diag + (ai - m) * dx + (aj - m) * dy) + c_v * abs(vk - gk) * dz
+                keys, nodes, size = _heap_push(keys, nodes, size, cand + h, v)
+    return g[goal], parent, expansions
+
+
+def _path_from_parents(parent: np.ndarray, start: int, goal: int, shape) -> np.ndarray:
+    path = [goal]
+    while path[-1] != start:
+        path.append(int(parent[path[-1]]))
+    return np.column_stack(np.unravel_index(np.asarray(path[::-1]), shape))
+
+
+def _fast(problem: SearchProblem, start: int, goal: int, use_heuristic: bool):
+    nx, ny, nz = problem.shape
+    lengths, transports = move_costs(problem.cell, problem.c_h, problem.c_v)
+    cost, parent, expansions = _astar_numba(
+        np.ascontiguousarray(problem.passable).ravel(), np.ascontiguousarray(problem.risk, dtype=float).ravel(),
+        np.ascontiguousarray(problem.penalty, dtype=float).ravel(), nx, ny, nz, *map(float, problem.cell),
+        float(problem.w_risk), float(problem.c_h), float(problem.c_v), start, goal, use_heuristic,
+        OFFSETS, CORNERS, CORNER_COUNTS, lengths, transports,
+    )
+    if not np.isfinite(cost):
+        return None, math.inf, int(expansions)
+    return _path_from_parents(parent, start, goal, problem.shape), float(cost), int(expansions)
+
+
+# --- reference backends -------------------------------------------------------------------------
+
+
+def _python(problem: SearchProblem, start: int, goal: int, use_heuristic: bool):
+    shape = problem.shape
+    passable, risk, penalty = problem.passable, problem.risk, problem.penalty
+    lengths, transports = move_costs(problem.cell, problem.c_h, problem.c_v)
+    goal_c = np.unravel_index(goal, shape)
+    start_c = tuple(int(v) for v in np.unravel_index(start, shape))
+    g = {start_c: 0.0}
+    parent: dict = {}
+    closed: set = set()
+    heap = [(0.0, start, start_c)]
+    expansions = 0
+    while heap:
+        _, _, u = heapq.heappop(heap)
+        if u in closed:
+            continue
+        closed.add(u)
+        expansions += 1
+        if u == tuple(goal_c):
+            break
+        for n, d in enumerate(OFFSETS):
+            v = (u[0] + int(d[0]), u[1] + int(d[1]), u[2] + int(d[2]))
+            if not all(0 <= a < s for a, s in zip(v, shape)) or v in closed:
+                continue
+            if not all(passable[u[0] + c[0], u[1] + c[1], u[2] + c[2]] for c in CORNERS[n, : CORNER_COUNTS[n]]):
+                continue
+            cand = g[u] + problem.w_risk * 0.5 * (risk[u] + risk[v]) * lengths[n] + transports[n] + penalty[v]
+            if cand < g.get(v, math.inf):
+                g[v] = cand
+                parent[v] = u
+                h = transport_lower_bound(v, goal_c, problem.cell, problem.c_h, problem.c_v) if use_heuristic else 0.0
+                heapq.heappush(heap, (cand + h, int(np.ravel_multi_index(v, shape)), v))
+    goal_t = tuple(int(v) for v in goal_c)
+    if goal_t not in g:
+        return None, math.inf, expansions
+    path = [goal_t]
+    while path[-1] != start_c:
+        path.append(parent[path[-1]])
+    return np.asarray(path[::-1], dtype=np.int64), g[goal_t], expansions
+
+
+def _networkx(problem: SearchProblem, start: int, goal: int, use_heuristic: bool):
+    import networkx as nx
+
+    from uamopt.graph import grid_graph
+
+    graph = grid_graph(problem.passable, problem.cell)
+    risk, penalty = problem.risk, problem.penalty
+    cell = np.asarray(problem.cell)
+
+    def weight(u, v, data):
+        step = (np.asarray(v) - np.asarray(u)) * cell
+        transport = problem.c_h * math.hypot(step[0], step[1]) + problem.c_v * abs(step[2])
+        return problem.w_risk * 0.5 * (risk[u] + risk[v]) * data["length"] + transport + penalty[v]
+
+    def heuristic(u, v):
+        return transport_lower_bound(u, v, problem.cell, problem.c_h, problem.c_v) if use_heuristic else 0.0
+
+    s, t = (tuple(int(x) for x in np.unravel_index(i, problem.shape)) for i in (start, goal))
+    try:
+        path = nx.astar_path(graph, s, t, heuristic=heuristic, weight=weight)
+    except (nx.NetworkXNoPath, nx.NodeNotFound):
+        return None, math.inf, 0
+    cost = sum(weight(a, b, graph.edges[a, b]) for a, b in zip(path[:-1], path[1:]))
+    return np.asarray(path, dtype=np.int64), float(cost), 0
+
+
+BACKENDS = {"fast": _fast, "python": _python, "networkx": _networkx}
+
+
+def grid_search(problem: SearchProblem, start: tuple[int, int, int], goal: tuple[int, int, int], *,
+                backend: str = "fast", heuristic: str = "transport") -> SearchResult:
+    """Cheapest path of cells from ``start`` to ``goal``.
+
+    Parameters
+    ----------
+    problem : SearchProblem
+    start, goal : (i, j, k)
+        Passable cells.
+    backend : {"fast", "python", "networkx"}
+    heuristic : {"transport", "zero"}
+
+    Returns
+    -------
+    SearchResult
+
+    Raises
+    ------
+    NoTrackError
+        When ``start`` or ``goal`` is impassable or no path joins them.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> free = np.ones((3, 3, 1), dtype=bool); zero = np.zeros((3, 3, 1))
+    >>> p = SearchProblem(free, zero, zero, (1.0, 1.0, 1.0), 0.0, 1.0, 1.0)
+    >>> r = grid_search(p, (0, 0, 0), (2, 2, 0))
+    >>> round(r.cost, 6), len(r.path)
+    (2.828427, 3)
+    """
+    if backend not in BACKENDS:
+        raise ValueError(f"backend must be one of {sorted(BACKENDS)}, got {backend!r}")
+    if heuristic not in ("transport", "zero"):
+        raise ValueError(f"heuristic must be 'transport' or 'zero', got {heuristic!r}")
+    for name, c in (("start", start), ("goal", goal)):
+        if not problem.passable[tuple(c)]:
+            raise NoTrackError(f"the {name} cell {tuple(int(v) for v in c)} is not passable", "track search",
+                               "move it out of buildings, no-fly zones and the clearance margin")
+    s = int(np.ravel_multi_index(tuple(start), problem.shape))
+    t = int(np.ravel_multi_index(tuple(goal), problem.shape))
+    started = time.perf_counter()
+    path, cost, expansions = BACKENDS[backend](problem, s, t, heuristic == "transport")
+    seconds = time.perf_counter() - started
+    if path is None:
+        raise NoTrackError(f"no admissible track joins cell {tuple(start)} and cell {tuple(goal)}", "track search",
+                           "the destination is walled off by buildings, no-fly zones or the altitude band; "
+                           "move it or relax grid.h_*/tracks.clearance_m")
+    return SearchResult(path=path, cost=cost, expansions=expansions, seconds=seconds, backend=backend,
+                        heuristic=heuristic)

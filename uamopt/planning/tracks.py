@@ -1,0 +1,280 @@
+"""The four stages of Fig. 18 / Table 2: shortest, initial, equivalent and optimal track.
+
+- **shortest**: standard A* on transport cost alone (Eq. 12), under the same constraints.
+- **initial**: A* on Eqs. 10–13 plus the safety-buffer penalty μ·R(t) (Eqs. 34–35).
+- **equivalent**: the initial track's cells form a corridor; the track may pass anywhere inside
+  it. The shortest polyline through the corridor — one point on the shared face (edge, corner)
+  of each pair of consecutive cells — is a second-order cone program, solved exactly with cvxpy
+  (``tracks.equivalent = "exact"``). The paper's rule, the midpoint of consecutive cell centres,
+  is a feasible point of that program, so the exact track is never longer; both are reported.
+- **optimal**: a cubic smoothing spline through the equivalent track (scipy ``splprep``, chord
+  parameter, mean deviation ``tracks.smoothing_m``), sampled densely; wherever the smoothed curve
+  leaves the admissible cells (band, clearance, obstacles, no-fly) it is replaced by the
+  equivalent track between the enclosing waypoints, until every piece is admissible.
+
+Each stage's metrics are recomputed from its own waypoints: the risk cost is Eq. 11 taken as
+the exact line integral of R along the polyline (for centre-to-centre moves this is Eq. 11
+itself: half of each move lies in each cell), the transport cost is Eq. 12.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import cvxpy as cp
+import numpy as np
+from scipy.interpolate import splev, splprep
+
+from uamopt.errors import GridError, NoTrackError, UamoptError
+from uamopt.geometry import polyline_in_mask, polyline_pieces
+from uamopt.planning.problem import PlanningModel
+from uamopt.planning.search import grid_search
+
+STAGES = ("shortest", "initial", "equivalent", "optimal")
+
+
+@dataclass(frozen=True)
+class TrackStage:
+    """One stage's track and its metrics (INTERFACES.md ``tracks.json``)."""
+
+    name: str
+    waypoints: np.ndarray  # (n, 3), m
+    risk_cost: float  # Eq. 11
+    transport_cost: float  # Eq. 12, ¥
+    objective: float  # Eq. 10
+    buffer_cost: float  # Σ μ·R(t) over the cells entered (Eq. 34)
+    length_m: float
+    seconds: float  # this stage's own computing time
+    extra: dict = field(default_factory=dict)
+
+    @property
+    def n_waypoints(self) -> int:
+        return len(self.waypoints)
+
+    def as_dict(self) -> dict:
+        return {
+            "waypoints": self.waypoints.tolist(), "risk_cost": self.risk_cost,
+            "transport_cost": self.transport_cost, "objective": self.objective, "buffer_cost": self.buffer_cost,
+            "n_waypoints": self.n_waypoints, "length_m": self.length_m, "seconds": self.seconds, **self.extra,
+        }
+
+
+def track_metrics(model: PlanningModel, waypoints: np.ndarray) -> dict:
+    """Eq. 11 (line integral of R), Eq. 12 and Eq. 10 for a polyline, and its length (Eq. 17)."""
+    pts = np.asarray(waypoints, dtype=float)
+    step = np.diff(pts, axis=0)
+    length = float(np.linalg.norm(step, axis=1).sum())
+    cells, s0, s1 = polyline_pieces(pts, model.field.grid.cell)
+    cells = np.clip(cells, 0, np.asarray(model.risk.shape) - 1)
+    risk_cost = float(np.sum(model.risk[tuple(cells.T)] * (s1 - s0)))
+    transport = float(model.c_h * np.hypot(step[:, 0], step[:, 1]).sum() + model.c_v * np.abs(step[:, 2]).sum())
+    # Safety buffer exposure (Eq. 34): μ·R(t) for every cell entered after the first.
+    entered = cells[np.concatenate([[False], np.any(np.diff(cells, axis=0) != 0, axis=1)])]
+    buffer = float(model.scenario.tracks.buffer_penalty * model.shell_count[tuple(entered.T)].sum())
+    w4, w5 = model.scenario.tracks.weights
+    return {"risk_cost": risk_cost, "transport_cost": transport, "objective": w4 * risk_cost + w5 * transport,
+            "buffer_cost": buffer, "length_m": length}
+
+
+def _stage(model: PlanningModel, name: str, waypoints: np.ndarray, seconds: float, **extra) -> TrackStage:
+    return TrackStage(name=name, waypoints=np.asarray(waypoints, dtype=float), seconds=seconds, extra=extra,
+                      **track_metrics(model, waypoints))
+
+
+def endpoint_cell(model: PlanningModel, point, label: str) -> tuple[int, int, int]:
+    """The cell of an origin/destination, with a clear error when it cannot be flown from."""
+    grid, field_ = model.field.grid, model.field
+    where = f"--{'from' if label == 'origin' else 'to'} {','.join(f'{v:g}' for v in point)}"
+    try:
+        cell = grid.index_of(tuple(point))
+    except GridError:
+        raise UamoptError(f"{label} {tuple(point)} is outside the grid", where,
+                          f"give x, y, z inside {tuple(round(e, 1) for e in grid.extent)} m") from None
+    low, high = field_.band
+    if not low <= point[2] <= high:
+        raise UamoptError(f"{label} altitude {point[2]:g} m is outside the band {low:g}-{high:g} m (Eq. 14)", where,
+                          "choose an altitude inside the band")
+    if field_.obstacle[cell]:
+        raise UamoptError(f"{label} is inside a building (cell {cell})", where, "move it above the roofs or into the street")
+    if field_.no_fly[cell]:
+        raise UamoptError(f"{label} is inside a no-fly zone (cell {cell})", where, "move it out of the zone")
+    if not model.admissible[cell]:
+        raise UamoptError(f"{label} is closer than s_min = {model.scenario.tracks.clearance_m:g} m to a building (cell {cell})",
+                          where, "move it away from the building or lower tracks.clearance_m")
+    return cell
+
+
+def _grid_waypoints(model: PlanningModel, path: np.ndarray) -> np.ndarray:
+    """The paper's waypoints of a cell path: the centres of its cells, origin cell to goal cell
+    (Sec. 4.2: p_n = (i_n, j_n, k_n)). The exact origin and destination, which lie inside the end
+    cells, are where the equivalent and optimal tracks start and end."""
+    return (path + 0.5) * np.asarray(model.field.grid.cell)
+
+
+def corridor_boxes(path: np.ndarray, cell) -> tuple[np.ndarray, np.ndarray]:
+    """Lower and upper corners of the shared face/edge/corner of consecutive corridor cells."""
+    size = np.asarray(cell, dtype=float)
+    lo = np.maximum(path[:-1], path[1:]) * size
+    hi = (np.minimum(path[:-1], path[1:]) + 1) * size
+    return lo, hi
+
+
+def simplify(points: np.ndarray, tol: float = 1e-7) -> np.ndarray:
+    """Drop repeated points and interior points collinear with their neighbours."""
+    pts = np.asarray(points, dtype=float)
+    keep = np.concatenate([[True], np.linalg.norm(np.diff(pts, axis=0), axis=1) > tol])
+    pts = pts[keep]
+    changed = True
+    while changed and len(pts) > 2:
+        a, b, c = pts[:-2], pts[1:-1], pts[2:]
+        ab, bc = b - a, c - b
+        cross = np.linalg.norm(np.cross(ab, bc), axis=1)
+        straight = (cross <= tol * np.linalg.norm(ab, axis=1) * np.linalg.norm(bc, axis=1) + tol) & (
+            np.einsum("ij,ij->i", ab, bc) > 0)
+        # drop every other collinear point per pass so neighbours are re-checked
+        drop = np.zeros(len(pts), dtype=bool)
+        idx = np.flatnonzero(straight) + 1
+        drop[idx[::2]] = True
+        changed = bool(drop.any())
+        pts = pts[~drop]
+    return pts
+
+
+def midpoint_track(path: np.ndarray, cell, origin, destination) -> np.ndarray:
+    """The paper's equivalent track: the midpoints of consecutive cell centres (Sec. 5.1)."""
+    lo, hi = corridor_boxes(path, cell)
+    return simplify(np.vstack([origin, 0.5 * (lo + hi), destination]))
+
+
+def exact_equivalent_track(path: np.ndarray, cell, origin, destination, *, model: PlanningModel | None = None) -> np.ndarray:
+    """Shortest polyline from origin to destination through the corridor of ``path`` cells.
+
+    One point q_i on the closed intersection of cells i−1 and i; minimise Σ‖q_{i+1} − q_i‖ — a
+    second-order cone program (cvxpy, Clarabel). Each segment then lies in one corridor cell.
+
+    With ``model`` given (variant ``tracks.equivalent = "exact_cost"``) the program minimises
+    Eq. 10 instead: Σ ω4 R_i ‖Δp_i‖ + ω5 (c_h ‖Δxy_i‖ + c_v |Δz_i|), segment i in cell i with
+    risk R_i. Still convex; its optimum is never worse than the midpoint rule's on Eq. 10.
+    """
+    lo, hi = corridor_boxes(path, cell)
+    if len(lo) == 0:
+        return np.vstack([origin, destination])
+    q = cp.Variable(lo.shape)
+    pts = cp.vstack([np.asarray(origin, dtype=float)[None, :], q, np.asarray(destination, dtype=float)[None, :]])
+    step = pts[1:] - pts[:-1]
+    if model is None:
+        objective = cp.sum(cp.norm(step, 2, axis=1))
+    else:
+        w4, w5 = model.scenario.tracks.weights
+        risk = model.risk[tuple(path.T)]
+        objective = (w4 * risk @ cp.norm(step, 2, axis=1) + w5 * model.c_h * cp.sum(cp.norm(step[:, :2], 2, axis=1))
+                     + w5 * model.c_v * cp.sum(cp.abs(step[:, 2])))
+    problem = cp.Problem(cp.Minimize(objective), [q >= lo, q <= hi])
+    problem.solve(solver=cp.CLARABEL)
+    if q.value is None:
+        raise NoTrackError("the equivalent-track program did not solve", "tracks.equivalent",
+                           f"solver status {problem.status}; use tracks.equivalent = 'midpoint'")
+    inner = np.clip(q.value, lo, hi)
+    return simplify(np.vstack([origin, inner, destination]), tol=1e-6)
+
+
+def smooth_track(model: PlanningModel, equivalent: np.ndarray) -> tuple[np.ndarray, dict]:
+    """Cubic smoothing spline through the equivalent track, repaired where it is not admissible."""
+    cell = np.asarray(model.field.grid.cell)
+    pts = np.asarray(equivalent, dtype=float)
+    if len(pts) < 4:
+        return pts, {"repaired_spans": 0, "smoothed": False}
+    chord = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(pts, axis=0), axis=1))])
+    u = chord / chord[-1]
+    weights = np.ones(len(pts))
+    weights[[0, -1]] = 1e3  # pin the origin and destination
+    tck, _ = splprep(pts.T, u=u, w=weights, k=3, s=len(pts) * model.scenario.tracks.smoothing_m**2)
+    n = max(int(np.ceil(chord[-1] / cell.min())), len(pts))  # about one sample per cell
+    us = np.union1d(np.linspace(0.0, 1.0, n + 1), u)
+    curve = np.column_stack(splev(us, tck))
+    curve[0], curve[-1] = pts[0], pts[-1]
+    linear = np.column_stack([np.interp(us, u, pts[:, d]) for d in range(3)])
+    use_linear = np.zeros(len(us), dtype=bool)
+    spans = 0
+    for _ in range(len(pts) + 2):
+        track = np.where(use_linear[:, None], linear, curve)
+        bad = ~polyline_in_mask(track, model.admissible, cell)
+        if not bad.any():
+            break
+        spans += int(np.count_nonzero(np.diff(np.concatenate([[0], bad.astype(int)])) == 1))
+        # widen each bad segment to the enclosing equivalent waypoints and fly the equivalent track there
+        seg = np.flatnonzero(bad)
+        first = np.searchsorted(u, us[seg], side="right") - 1
+        last = np.searchsorted(u, us[seg + 1], side="left")
+        for a, b in zip(u[np.clip(first, 0, len(u) - 1)], u[np.clip(last, 0, len(u) - 1)]):
+            use_linear |= (us >= a) & (us <= b)
+    else:  # pragma: no cover - the equivalent track itself is admissible
+        track = linear
+    return simplify(track, tol=1e-9), {"repaired_spans": spans, "smoothed": True}
+
+
+@dataclass(frozen=True)
+class TrackPlan:
+    """All stages of one origin-destination plan, in Table 2 order."""
+
+    origin: tuple[float, float, float]
+    destination: tuple[float, float, float]
+    stages: dict[str, TrackStage]
+    midpoint: TrackStage | None = None
+
+    def as_dict(self) -> dict:
+        out = {"stages": {k: v.as_dict() for k, v in self.stages.items()},
+               "origin": list(self.origin), "destination": list(self.destination)}
+        if self.midpoint is not None:
+            out["equivalent_midpoint_rule"] = self.midpoint.as_dict()
+        return out
+
+
+def plan_track(model: PlanningModel, origin, destination, *, backend: str | None = None,
+               heuristic: str | None = None) -> TrackPlan:
+    """Plan all four stages from ``origin`` to ``destination`` (x, y, z in metres).
+
+    Raises
+    ------
+    UamoptError
+        Origin or destination outside the grid or band, inside a building, no-fly zone or the
+        clearance margin; the track longer than the range L_e (Eq. 17).
+    NoTrackError
+        No admissible track joins them.
+    """
+    cfg = model.scenario.tracks
+    backend = backend or cfg.search
+    heuristic = heuristic or cfg.heuristic
+    origin = np.asarray(origin, dtype=float)
+    destination = np.asarray(destination, dtype=float)
+    start, goal = endpoint_cell(model, origin, "origin"), endpoint_cell(model, destination, "destination")
+    cell = model.field.grid.cell
+    stages: dict[str, TrackStage] = {}
+    paths: dict[str, np.ndarray] = {}
+    for name in ("shortest", "initial"):
+        result = grid_search(model.search_problem(name), start, goal, backend=backend, heuristic=heuristic)
+        paths[name] = result.path
+        stages[name] = _stage(model, name, _grid_waypoints(model, result.path), result.seconds,
+                              search_cost=result.cost, expansions=result.expansions, cells=len(result.path))
+    path = paths["initial"]
+    t0 = time.perf_counter()
+    midpoint = _stage(model, "equivalent", midpoint_track(path, cell, origin, destination), 0.0, rule="midpoint")
+    t_mid = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    if cfg.equivalent in ("exact", "exact_cost"):
+        equivalent = exact_equivalent_track(path, cell, origin, destination,
+                                            model=model if cfg.equivalent == "exact_cost" else None)
+        rule = "exact shortest (SOCP)" if cfg.equivalent == "exact" else "exact Eq. 10 (SOCP)"
+        stages["equivalent"] = _stage(model, "equivalent", equivalent, time.perf_counter() - t0, rule=rule)
+    else:
+        stages["equivalent"] = TrackStage(**{**midpoint.__dict__, "seconds": t_mid})
+    t0 = time.perf_counter()
+    smoothed, info = smooth_track(model, stages["equivalent"].waypoints)
+    stages["optimal"] = _stage(model, "optimal", smoothed, time.perf_counter() - t0, **info)
+    limit = model.scenario.aircraft.range_m
+    if stages["optimal"].length_m > limit:
+        raise UamoptError(f"the track is {stages['optimal'].length_m:.0f} m long, beyond the range L_e = {limit:g} m (Eq. 17)",
+                          "aircraft.range_m", "choose closer points or an aircraft with a longer range")
+    return TrackPlan(tuple(map(float, origin)), tuple(map(float, destination)), stages,
+                     midpoint=TrackStage(**{**midpoint.__dict__, "seconds": t_mid}))
