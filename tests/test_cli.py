@@ -44,13 +44,72 @@ def test_risk_command_writes_the_interface_files(tmp_path):
 
 def test_reproduce_writes_the_report(tmp_path):
     out = tmp_path / "paper"
-    proc = run("reproduce", PAPER, "--out", str(out))
+    proc = run("reproduce", PAPER, "--out", str(out), "--set", "tracks.table2_cell_m=25", "--set", "tracks.table4_cells=[]")
     assert proc.returncode == 0, proc.stderr
     assert "report.md" in proc.stdout
     report = (out / "report.md").read_text()
     assert "Operational risk field" in report and "![risk map](risk.png)" in report
     assert "27.4684" in report  # terminal speed at m_p = 0 beside the reference 27.468
-    assert {"risk.npz", "risk.png", "summary.json", "report.md"} <= {p.name for p in out.iterdir()}
+    assert "Table 2 analogue" in report and "Route network" in report
+    expected = {"risk.npz", "risk.png", "summary.json", "report.md", "tracks.json", "tracks.png", "network.json", "network.png"}
+    assert expected <= {p.name for p in out.iterdir()}
+
+
+def test_plan_command(tmp_path):
+    out = tmp_path / "plan"
+    proc = run("plan", PAPER, "--from", "300,300,120", "--to", "2220,4220,120", "--out", str(out))
+    assert proc.returncode == 0, proc.stderr
+    doc = json.loads((out / "tracks.json").read_text())
+    assert list(doc["stages"]) == ["shortest", "initial", "equivalent", "optimal"]
+    for stage in doc["stages"].values():
+        pts = np.asarray(stage["waypoints"])
+        assert stage["n_waypoints"] == len(pts)
+        assert stage["length_m"] == pytest.approx(float(np.linalg.norm(np.diff(pts, axis=0), axis=1).sum()))
+    assert doc["stages"]["optimal"]["waypoints"][0] == [300.0, 300.0, 120.0]
+    assert (out / "tracks.png").stat().st_size > 10_000
+
+
+def test_network_command(tmp_path):
+    out = tmp_path / "net"
+    proc = run("network", PAPER, "--out", str(out))
+    assert proc.returncode == 0, proc.stderr
+    doc = json.loads((out / "network.json").read_text())
+    assert len(doc["routes"]) == 20 and doc["routes"]["V1-V4"]["origin"] == "V1"
+
+
+@pytest.mark.parametrize("args, fragment", [
+    (["--from", "300,300,50"], "outside the band"),
+    (["--from", "300,300"], "not a point"),
+    (["--from", "9000,300,120"], "outside the grid"),
+    (["--set", "aircraft.range_m=2000"], "range"),
+])
+def test_plan_bad_input(tmp_path, args, fragment):
+    out = tmp_path / "o"
+    assert_one_line_error(run("plan", PAPER, "--out", str(out), *args), fragment)
+    assert not out.exists()
+
+
+def test_plan_origin_in_building_and_unreachable_destination(tmp_path):
+    """A DSM city with a closed ring of 320 m towers: inside a tower, and inside the ring."""
+    import rasterio
+    from rasterio.transform import from_origin
+
+    dsm = np.zeros((400, 400), dtype="float32")  # 1 m pixels, rows run south
+    dsm[100:300, 100:300] = 320.0  # above the whole band
+    dsm[140:260, 140:260] = 0.0  # the courtyard inside the ring
+    path = tmp_path / "ring.tif"
+    with rasterio.open(path, "w", driver="GTiff", height=400, width=400, count=1, dtype="float32",
+                       crs="EPSG:32633", transform=from_origin(500000, 6000400, 1, 1)) as dst:
+        dst.write(dsm, 1)
+    scenario = tmp_path / "ring.toml"
+    scenario.write_text(f"[grid]\ncell = [20.0, 20.0, 30.0]\n[city]\nsource = 'dsm'\ndsm = '{path}'\n"
+                        "[tracks]\nclearance_m = 0.0\n")
+    out = tmp_path / "o"
+    assert_one_line_error(run("plan", str(scenario), "--from", "30,30,120", "--to", "120,120,135", "--out", str(out)),
+                          "inside a building")
+    assert_one_line_error(run("plan", str(scenario), "--from", "30,30,120", "--to", "200,200,120", "--out", str(out)),
+                          "no admissible track")
+    assert not out.exists()
 
 
 def test_helsinki_from_openstreetmap(tmp_path):

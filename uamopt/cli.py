@@ -7,8 +7,12 @@ results are staged and moved into ``--out`` only when complete.
 from __future__ import annotations
 
 import argparse
+import math
 import sys
+import time
 from pathlib import Path
+
+import numpy as np
 
 from uamopt.errors import UamoptError
 
@@ -54,7 +58,93 @@ def _risk_stage(scenario, stage: Path, bar) -> dict:
     bar.update(1)
     summary = risk_summary(run)
     write_json(stage / "summary.json", summary)
-    return summary
+    return run, summary
+
+
+def _point(text: str | None, option: str, default) -> tuple[float, float, float]:
+    """Parse ``X,Y,Z`` (metres) of --from/--to; the scenario's P_O/P_D when omitted."""
+    if text is None:
+        return tuple(float(v) for v in default)  # type: ignore[return-value]
+    try:
+        values = tuple(float(v) for v in text.split(","))
+    except ValueError:
+        values = ()
+    if len(values) != 3 or not all(map(math.isfinite, values)):
+        raise UamoptError(f"{option} {text!r} is not a point", option, "write X,Y,Z in metres, e.g. 300,300,120")
+    return values  # type: ignore[return-value]
+
+
+def _planning(scenario, bar):
+    from uamopt.planning import planning_model
+    from uamopt.stages import compute_risk
+
+    bar.set_description("risk field")
+    run = compute_risk(scenario)
+    bar.update(1)
+    bar.set_description("planning model")
+    model = planning_model(scenario, run.field)
+    bar.update(1)
+    return run, model
+
+
+def _plan_stage(scenario, model, origin, destination, stage: Path, bar) -> dict:
+    """Plan the four stages and write tracks.json and tracks.png into ``stage``."""
+    from uamopt.outputs import write_json
+    from uamopt.planning import plan_track
+    from uamopt.plot_tracks import plot_tracks
+
+    bar.set_description("tracks")
+    plan = plan_track(model, origin, destination)
+    bar.update(1)
+    doc = {**plan.as_dict(), "scenario": {"name": scenario.name, "file": scenario.source,
+                                          "cell": list(model.field.grid.cell), "weights": list(scenario.tracks.weights)}}
+    write_json(stage / "tracks.json", doc)
+    plot_tracks(model, plan, stage / "tracks.png", title=scenario.name)
+    bar.update(1)
+    return doc
+
+
+def _network_stage(scenario, model, stage: Path, bar) -> dict:
+    """Plan every route in both directions and write network.json and network.png."""
+    from uamopt.outputs import write_json
+    from uamopt.planning.network import network_document, plan_network
+    from uamopt.plot_tracks import plot_network
+
+    bar.set_description("network")
+    network = plan_network(model, progress=bar)
+    doc = network_document(model, network)
+    write_json(stage / "network.json", doc)
+    plot_network(model, {k: np.asarray(v["waypoints"]) for k, v in doc["routes"].items()}, stage / "network.png",
+                 vertiports=scenario.network.vertiports)
+    return {"doc": doc, "plans": network}
+
+
+def cmd_plan(args) -> int:
+    from uamopt.outputs import check_out_dir, staged_output
+
+    scenario = _load(args)
+    origin = _point(args.origin, "--from", scenario.tracks.origin)
+    destination = _point(args.destination, "--to", scenario.tracks.destination)
+    check_out_dir(args.out)
+    with _progress(4, "plan") as bar, staged_output(args.out) as stage:
+        _, model = _planning(scenario, bar)
+        doc = _plan_stage(scenario, model, origin, destination, stage, bar)
+    opt = doc["stages"]["optimal"]
+    print(f"optimal track: {opt['length_m']:.0f} m, ¥{opt['transport_cost']:.2f}, risk {opt['risk_cost']:.1f} "
+          f"-> {Path(args.out) / 'tracks.json'}")
+    return 0
+
+
+def cmd_network(args) -> int:
+    from uamopt.outputs import check_out_dir, staged_output
+
+    scenario = _load(args)
+    check_out_dir(args.out)
+    with _progress(2 + 2 * 10, "network") as bar, staged_output(args.out) as stage:
+        _, model = _planning(scenario, bar)
+        result = _network_stage(scenario, model, stage, bar)
+    print(f"network: {len(result['doc']['routes'])} tracks -> {Path(args.out) / 'network.json'}")
+    return 0
 
 
 def cmd_risk(args) -> int:
@@ -63,7 +153,7 @@ def cmd_risk(args) -> int:
     scenario = _load(args)
     check_out_dir(args.out)
     with _progress(2, "risk") as bar, staged_output(args.out) as stage:
-        summary = _risk_stage(scenario, stage, bar)
+        _, summary = _risk_stage(scenario, stage, bar)
     print(
         f"risk field: {summary['cells']:,} cells, {100 * summary['unsafe_share']:.1f} % unsafe, "
         f"{summary['seconds']['risk']:.2f} s -> {Path(args.out) / 'risk.npz'}"
@@ -71,17 +161,52 @@ def cmd_risk(args) -> int:
     return 0
 
 
+def _plan_at(scenario, side: float, extent) -> tuple:
+    """Risk field, planning model and the P_O → P_D plan at cubic cells of ``side`` metres."""
+    from uamopt.planning import plan_track, planning_model
+    from uamopt.stages import compute_risk
+
+    started = time.perf_counter()
+    fine = scenario.with_overrides([f"grid.cell=[{side},{side},{side}]", f"grid.extent={_toml_list(extent)}"])
+    model = planning_model(fine, compute_risk(fine).field)
+    plan = plan_track(model, fine.tracks.origin, fine.tracks.destination)
+    return fine, model, plan, time.perf_counter() - started
+
+
 def cmd_reproduce(args) -> int:
-    from uamopt.outputs import check_out_dir, staged_output
-    from uamopt.report import risk_section, write_report
+    from uamopt.outputs import check_out_dir, staged_output, write_json
+    from uamopt.planning import planning_model
+    from uamopt.plot_tracks import plot_tracks
+    from uamopt.report import network_section, risk_section, table2_section, table4_section, write_report
 
     scenario = _load(args)
     check_out_dir(args.out)
-    with _progress(2, "reproduce") as bar, staged_output(args.out) as stage:
-        summary = _risk_stage(scenario, stage, bar)
-        write_report(stage / "report.md", scenario, [risk_section(scenario, summary)])
+    t2 = scenario.tracks.table2_cell_m
+    sides = [t2] + [c for c in scenario.tracks.table4_cells if c != t2]
+    with _progress(4 + 20 + len(sides), "reproduce") as bar, staged_output(args.out) as stage:
+        run, summary = _risk_stage(scenario, stage, bar)
+        model = planning_model(scenario, run.field)
+        network = _network_stage(scenario, model, stage, bar)
+        plans = {}
+        for side in sides:
+            bar.set_description(f"track at {side:g} m cells")
+            plans[side] = _plan_at(scenario, side, run.grid.extent)
+            bar.update(1)
+        fine, fine_model, plan, _ = plans[t2]
+        tracks = {**plan.as_dict(), "scenario": {"name": scenario.name, "file": scenario.source,
+                                                 "cell": list(fine_model.field.grid.cell)}}
+        write_json(stage / "tracks.json", tracks)
+        plot_tracks(fine_model, plan, stage / "tracks.png", title=f"{scenario.name}, {t2:g} m cells")
+        table4 = [(side, plans[side][2], plans[side][3]) for side in scenario.tracks.table4_cells]
+        sections = [risk_section(scenario, summary), table2_section(fine, fine_model, tracks),
+                    table4_section(scenario, table4), network_section(scenario, network["doc"])]
+        write_report(stage / "report.md", scenario, sections)
     print(f"report: {Path(args.out) / 'report.md'}")
     return 0
+
+
+def _toml_list(values) -> str:
+    return "[" + ",".join(f"{float(v)!r}" for v in values) + "]"
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -99,6 +224,10 @@ def build_parser() -> argparse.ArgumentParser:
         return p
 
     command("risk", cmd_risk, "compute the operational risk field: risk.npz, risk.png, summary.json", "out/risk")
+    plan = command("plan", cmd_plan, "plan one track in four stages: tracks.json, tracks.png", "out/plan")
+    plan.add_argument("--from", dest="origin", metavar="X,Y,Z", help="origin, m (default: tracks.origin, P_O)")
+    plan.add_argument("--to", dest="destination", metavar="X,Y,Z", help="destination, m (default: tracks.destination, P_D)")
+    command("network", cmd_network, "plan one track per route and direction: network.json, network.png", "out/network")
     command("reproduce", cmd_reproduce, "run every stage that applies and write report.md with figures", "out/reproduce")
     return parser
 

@@ -94,3 +94,117 @@ def write_report(path, scenario: Scenario, sections: list[str]) -> None:
         "",
     ]
     path.write_text("\n".join(head) + "\n".join(sections), encoding="utf-8")
+
+
+# Table 2 of the paper (P_O -> P_D): shortest, initial, equivalent, optimal.
+PAPER_TABLE2 = {
+    "operational risk": (196, 174, 174, 181),
+    "transport cost (¥)": (27.1527, 32.7379, 32.0715, 30.8265),
+    "waypoints": (386, 456, 453, 432),
+    "computational time (s)": (68.71, 90.58, 101.96, 108.97),
+}
+PAPER_TABLE4 = {10.0: (196, 27.1527, 386, 68.71), 5.0: (163.33, 25.7975, 636, 659.52)}
+
+
+def _change(value: float, base: float) -> str:
+    return f" ({100 * (value - base) / base:+.1f} %)" if base else ""
+
+
+def straight_segment_cost(scenario: Scenario, length_m: float = 4365.0) -> float:
+    """Eq. 12 for a straight level segment: c_h · L · c_e · τ(m_p) (MODEL_NOTES: ¥27.15)."""
+    from uamopt.planning.problem import transport_rates
+
+    return transport_rates(scenario)[0] * length_m
+
+
+def table2_section(scenario: Scenario, model, tracks: dict) -> str:
+    """Table 2 analogue beside the paper's figures, with the cumulative computing time."""
+    st = tracks["stages"]
+    names = ("shortest", "initial", "equivalent", "optimal")
+    cumulative = 0.0
+    times = []
+    for n in names:
+        cumulative += st[n]["seconds"]
+        times.append(cumulative)
+    rows = [
+        ("operational risk C_R (Eq. 11)", [st[n]["risk_cost"] for n in names], PAPER_TABLE2["operational risk"], ".1f"),
+        ("safety-buffer exposure Σ μ·R(t) (Eq. 34)", [st[n]["buffer_cost"] for n in names], None, ".0f"),
+        ("transport cost C_T (¥, Eq. 12)", [st[n]["transport_cost"] for n in names], PAPER_TABLE2["transport cost (¥)"], ".4f"),
+        ("waypoints", [st[n]["n_waypoints"] for n in names], PAPER_TABLE2["waypoints"], "d"),
+        ("length (m)", [st[n]["length_m"] for n in names], None, ".0f"),
+        ("computational time, cumulative (s)", times, PAPER_TABLE2["computational time (s)"], ".3f"),
+    ]
+    g = model.field.grid
+    o, d = tracks["origin"], tracks["destination"]
+    lines = [
+        "## Track planning: Table 2 analogue (Sec. 6.2, Fig. 18)",
+        "",
+        f"P_O = ({', '.join(f'{v:g}' for v in o)}) → P_D = ({', '.join(f'{v:g}' for v in d)}) m, cells "
+        f"{' × '.join(f'{c:g}' for c in g.cell)} m, ω4 = {scenario.tracks.weights[0]:g}, ω5 = {scenario.tracks.weights[1]:g}, "
+        f"μ = {scenario.tracks.buffer_penalty:g}, buffer n_s = {model.n_s}. Ours first, the paper's in brackets "
+        "(its instance, not ours: compare the shape). Changes are relative to the shortest track.",
+        "",
+        "| index | shortest | initial | equivalent | optimal |",
+        "|---|---|---|---|---|",
+    ]
+    for label, ours, paper, fmt in rows:
+        cells = []
+        for i, v in enumerate(ours):
+            text = format(int(v) if fmt == "d" else v, fmt) + (_change(v, ours[0]) if i else "")
+            if paper is not None:
+                text += f" [{paper[i]:g}]"
+            cells.append(text)
+        lines.append(f"| {label} | " + " | ".join(cells) + " |")
+    mid = tracks.get("equivalent_midpoint_rule")
+    eq = st["equivalent"]
+    lines += [
+        "",
+        f"Equivalent track, exact shortest polyline through the corridor (SOCP): {eq['length_m']:.1f} m, "
+        f"¥{eq['transport_cost']:.4f}; the paper's midpoint rule: {mid['length_m']:.1f} m, ¥{mid['transport_cost']:.4f}."
+        if mid else "",
+        "",
+        f"Check of Eq. 12–13 (MODEL_NOTES): a straight level 4365 m segment with m_p = {scenario.aircraft.payload_kg:g} kg "
+        f"costs ¥{straight_segment_cost(scenario):.4f} (paper's shortest track: ¥27.1527).",
+        "",
+        "![tracks](tracks.png)",
+        "",
+    ]
+    return "\n".join(lines) + "\n"
+
+
+def table4_section(scenario: Scenario, results: list) -> str:
+    """Table 4 analogue: the optimal track at finer cells (cell side, plan, seconds)."""
+    if not results:
+        return ""
+    lines = [
+        "## Track planning at finer cells: Table 4 analogue (Sec. 6.3.2)",
+        "",
+        "Optimal track P_O → P_D; computational time includes the risk field and planning model. "
+        "The paper's figures in brackets (its Table 4 reports the shortest-track column of Table 2).",
+        "",
+        "| cells | operational risk C_R | transport cost (¥) | waypoints | length (m) | time (s) |",
+        "|---|---|---|---|---|---|",
+    ]
+    for side, plan, seconds in results:
+        o = plan.stages["optimal"]
+        p = PAPER_TABLE4.get(float(side))
+        ref = (lambda i: f" [{p[i]:g}]") if p else (lambda i: "")
+        lines.append(f"| {side:g} m | {o.risk_cost:.1f}{ref(0)} | {o.transport_cost:.4f}{ref(1)} | {o.n_waypoints}{ref(2)} | "
+                     f"{o.length_m:.0f} | {seconds:.2f}{ref(3)} |")
+    return "\n".join(lines) + "\n\n"
+
+
+def network_section(scenario: Scenario, doc: dict) -> str:
+    """The route network: one optimal track per route and direction."""
+    lines = [
+        "## Route network (Sec. 6.2)",
+        "",
+        f"{len(doc['routes'])} tracks (layering: {doc['layering']}; directions on separate cruise layers).",
+        "",
+        "| route | layer k | length (m) | transport cost (¥) | risk C_R |",
+        "|---|---|---|---|---|",
+    ]
+    for name, r in doc["routes"].items():
+        lines.append(f"| {name} | {r['layer_k'] if r['layer_k'] is not None else '-'} | {r['length_m']:.0f} | "
+                     f"{r['transport_cost']:.2f} | {r['risk_cost']:.1f} |")
+    return "\n".join(lines + ["", "![network](network.png)", ""]) + "\n"

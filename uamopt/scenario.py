@@ -174,6 +174,19 @@ class TracksConfig(_Section):
     clearance_m: NonNegFloat = Field(50.0, description="s_min, building clearance, m (Eq. 15)")
     buffer_penalty: NonNegFloat = Field(100.0, description="μ, safety-buffer shell penalty (Eq. 35)")
     risk_model: Literal["binary", "continuous"] = Field("binary", description="Eq. 9 field or Eq. 8 field")
+    origin: tuple[float, float, float] = Field(
+        (300.0, 300.0, 120.0), description="P_O, default origin of `uamopt plan`, m (Table B.3: (30, 30, 120) in 10 m units)"
+    )
+    destination: tuple[float, float, float] = Field(
+        (2220.0, 4220.0, 120.0), description="P_D, default destination of `uamopt plan`, m (Table B.3: (222, 422, 120))"
+    )
+    table2_cell_m: PositiveFloat = Field(
+        10.0, description="cell side (m) of the Table 2 comparison in `uamopt reproduce` (the paper's Table 2 is "
+        "its Table 4's 10 m column)"
+    )
+    table4_cells: tuple[PositiveFloat, ...] = Field(
+        (10.0, 5.0), description="cell sides (m) of the Table 4 comparison in `uamopt reproduce`; [] skips it"
+    )
     wind_speed_mps: NonNegFloat = Field(0.0, description="v_wr, actual wind, m/s; must not exceed v_we (Eq. 19)")
     search: Literal["fast", "python", "networkx"] = Field("fast", description="search backend")
     heuristic: Literal["transport", "zero"] = Field(
@@ -184,7 +197,7 @@ class TracksConfig(_Section):
         "exact Eq. 10 optimum (SOCP), or the paper's midpoint rule"
     )
     smoothing_m: NonNegFloat = Field(
-        10.0, description="largest mean deviation of the smoothing spline from the equivalent track, m"
+        50.0, description="largest corner-rounding (fillet tangent) distance of the optimal track, m"
     )
     layering: Literal["direction", "none"] = Field(
         "direction", description="network: the two directions of a route on separate cruise layers (Sec. 4.1.2)"

@@ -8,7 +8,7 @@ Readings (MODEL_NOTES, paper Sec. 5.1):
 - Safety buffer (Eqs. 34–35): a box of n_s cells per axis around the cell entered,
   n_s = ⌈s_min/Δ⌉·2 + 1 (50 m cells → 3, 30 m layers → 5); R(t) counts the unsafe cells (Eq. 9:
   risky, obstacle or no-fly) on the box's outer shell; the move pays μ·R(t). Cells outside the
-  grid count as safe. Computed for all cells at once with a 3-D summed-area table.
+  grid count as unsafe. Computed for all cells at once with a 3-D summed-area table.
 - Transport cost (Eqs. 12–13): c_h·horizontal + c_v·|vertical| times c_e·τ(m_p),
   τ = 1 + (m_p/m_p,max)·τ_max.
 - Risk cost (Eq. 11) uses the binary field of Eq. 9 by default (``tracks.risk_model``), the
@@ -47,9 +47,9 @@ def buffer_cells(cell: tuple[float, float, float], clearance_m: float) -> tuple[
     return tuple(int(math.ceil(clearance_m / d - 1e-9)) * 2 + 1 for d in cell)  # type: ignore[return-value]
 
 
-def box_counts(mask: np.ndarray, half: tuple[int, int, int]) -> np.ndarray:
+def box_counts(mask: np.ndarray, half: tuple[int, int, int], outside: bool = False) -> np.ndarray:
     """Number of True cells in the box of half-widths ``half`` centred on every cell (int32);
-    cells beyond the grid count as False. A summed-area table: O(cells), no loop over cells."""
+    cells beyond the grid count as ``outside``. A summed-area table: O(cells), no loop over cells."""
     hx, hy, hz = half
     sat = np.zeros(tuple(n + 1 for n in mask.shape), dtype=np.int32)
     sat[1:, 1:, 1:] = mask.astype(np.int32).cumsum(0).cumsum(1).cumsum(2)
@@ -59,18 +59,26 @@ def box_counts(mask: np.ndarray, half: tuple[int, int, int]) -> np.ndarray:
     x0, x1 = lo[0][:, None, None], hi[0][:, None, None]
     y0, y1 = lo[1][None, :, None], hi[1][None, :, None]
     z0, z1 = lo[2][None, None, :], hi[2][None, None, :]
-    return (sat[x1, y1, z1] - sat[x0, y1, z1] - sat[x1, y0, z1] - sat[x1, y1, z0]
-            + sat[x0, y0, z1] + sat[x0, y1, z0] + sat[x1, y0, z0] - sat[x0, y0, z0])
+    inside = (sat[x1, y1, z1] - sat[x0, y1, z1] - sat[x1, y0, z1] - sat[x1, y1, z0]
+              + sat[x0, y0, z1] + sat[x0, y1, z0] + sat[x1, y0, z0] - sat[x0, y0, z0])
+    if not outside:
+        return inside
+    volume = (2 * hx + 1) * (2 * hy + 1) * (2 * hz + 1)
+    return inside + (volume - (x1 - x0) * (y1 - y0) * (z1 - z0)).astype(np.int32)
 
 
 def buffer_shell_count(unsafe: np.ndarray, n_s: tuple[int, int, int]) -> np.ndarray:
-    """R(t) of Eq. 35 for every cell: unsafe cells on the outer shell of its n_s box."""
+    """R(t) of Eq. 35 for every cell: unsafe cells on the outer shell of its n_s box.
+
+    Cells beyond the grid count as unsafe: airspace outside the modelled city is not known to be
+    safe, and counting it safe would make the domain's edge the most attractive place to fly.
+    """
     outer = tuple((n - 1) // 2 for n in n_s)
     inner = tuple(h - 1 for h in outer)
-    full = box_counts(unsafe, outer)
+    full = box_counts(unsafe, outer, outside=True)
     if min(inner) < 0:
         return full
-    return full - box_counts(unsafe, inner)  # type: ignore[arg-type]
+    return full - box_counts(unsafe, inner, outside=True)  # type: ignore[arg-type]
 
 
 def clearance_ok(obstacle: np.ndarray, cell: tuple[float, float, float], clearance_m: float) -> np.ndarray:

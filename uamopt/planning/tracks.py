@@ -7,10 +7,11 @@
   of each pair of consecutive cells — is a second-order cone program, solved exactly with cvxpy
   (``tracks.equivalent = "exact"``). The paper's rule, the midpoint of consecutive cell centres,
   is a feasible point of that program, so the exact track is never longer; both are reported.
-- **optimal**: a cubic smoothing spline through the equivalent track (scipy ``splprep``, chord
-  parameter, mean deviation ``tracks.smoothing_m``), sampled densely; wherever the smoothed curve
-  leaves the admissible cells (band, clearance, obstacles, no-fly) it is replaced by the
-  equivalent track between the enclosing waypoints, until every piece is admissible.
+- **optimal**: the equivalent track smoothed with local cubic curves at its turns (the paper's
+  cubic interpolation around the entry and exit nodes of each integrated cell): each corner is
+  rounded by a cubic Bézier fillet inside the corner's triangle, shrunk where it would leave the
+  corridor or enter a risky or inadmissible cell. Fillets cut corners, so the optimal track is
+  never longer than the equivalent one.
 
 Each stage's metrics are recomputed from its own waypoints: the risk cost is Eq. 11 taken as
 the exact line integral of R along the polyline (for centre-to-centre moves this is Eq. 11
@@ -24,7 +25,6 @@ from dataclasses import dataclass, field
 
 import cvxpy as cp
 import numpy as np
-from scipy.interpolate import splev, splprep
 
 from uamopt.errors import GridError, NoTrackError, UamoptError
 from uamopt.geometry import polyline_in_mask, polyline_pieces
@@ -179,39 +179,77 @@ def exact_equivalent_track(path: np.ndarray, cell, origin, destination, *, model
     return simplify(np.vstack([origin, inner, destination]), tol=1e-6)
 
 
-def smooth_track(model: PlanningModel, equivalent: np.ndarray) -> tuple[np.ndarray, dict]:
-    """Cubic smoothing spline through the equivalent track, repaired where it is not admissible."""
+def smoothing_mask(model: PlanningModel, corridor: np.ndarray) -> np.ndarray:
+    """Where the smoothed track may fly: the corridor, and admissible cells that are safe (Eq. 9
+    R = 0). Cutting a corner through a risky cell the corridor avoided would undo the planner's
+    work, so that counts as a violation to repair."""
+    mask = model.admissible & ~model.field.unsafe
+    mask[tuple(np.asarray(corridor).T)] = True
+    return mask
+
+
+def corner_fillets(points: np.ndarray, tangent: np.ndarray, samples: int = 8) -> np.ndarray:
+    """Round every interior corner of a polyline with a cubic Bézier fillet.
+
+    At vertex V with legs towards its neighbours, the fillet runs from A = V − t·u_in to
+    B = V + t·u_out with control points A + ⅔(V − A) and B + ⅔(V − B) (the cubic form of the
+    quadratic Bézier through A, V, B), sampled at ``samples`` points (the paper's "eight
+    coordinate points" around each turn, Sec. 5.1). The fillet lies in the triangle A V B, so it
+    is shorter than the corner it replaces, in length and in each of Eq. 12's horizontal and
+    vertical parts. ``tangent`` holds t per interior vertex (0 keeps the corner).
+    """
+    pts = np.asarray(points, dtype=float)
+    out = [pts[:1]]
+    s = np.linspace(0.0, 1.0, samples)[:, None]
+    for i in range(1, len(pts) - 1):
+        v, t = pts[i], float(tangent[i - 1])
+        if t <= 0:
+            out.append(v[None, :])
+            continue
+        u_in = (v - pts[i - 1]) / np.linalg.norm(v - pts[i - 1])
+        u_out = (pts[i + 1] - v) / np.linalg.norm(pts[i + 1] - v)
+        a, b = v - t * u_in, v + t * u_out
+        c1, c2 = a + (2.0 / 3.0) * (v - a), b + (2.0 / 3.0) * (v - b)
+        out.append((1 - s) ** 3 * a + 3 * (1 - s) ** 2 * s * c1 + 3 * (1 - s) * s**2 * c2 + s**3 * b)
+    out.append(pts[-1:])
+    return np.vstack(out)
+
+
+def smooth_track(model: PlanningModel, equivalent: np.ndarray, corridor: np.ndarray | None = None) -> tuple[np.ndarray, dict]:
+    """The optimal track: the equivalent track with its corners rounded (:func:`corner_fillets`).
+
+    Each corner's tangent distance starts at min(``tracks.smoothing_m``, half of each leg) and is
+    halved, corner by corner, while its fillet leaves the allowed cells (:func:`smoothing_mask`:
+    the corridor and safe admissible cells; all admissible cells without a corridor); after six
+    halvings the corner stays sharp. The result is admissible by construction and never longer
+    (nor costlier in Eq. 12) than the equivalent track.
+    """
     cell = np.asarray(model.field.grid.cell)
+    allowed = model.admissible if corridor is None else smoothing_mask(model, corridor)
     pts = np.asarray(equivalent, dtype=float)
-    if len(pts) < 4:
-        return pts, {"repaired_spans": 0, "smoothed": False}
-    chord = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(pts, axis=0), axis=1))])
-    u = chord / chord[-1]
-    weights = np.ones(len(pts))
-    weights[[0, -1]] = 1e3  # pin the origin and destination
-    tck, _ = splprep(pts.T, u=u, w=weights, k=3, s=len(pts) * model.scenario.tracks.smoothing_m**2)
-    n = max(int(np.ceil(chord[-1] / cell.min())), len(pts))  # about one sample per cell
-    us = np.union1d(np.linspace(0.0, 1.0, n + 1), u)
-    curve = np.column_stack(splev(us, tck))
-    curve[0], curve[-1] = pts[0], pts[-1]
-    linear = np.column_stack([np.interp(us, u, pts[:, d]) for d in range(3)])
-    use_linear = np.zeros(len(us), dtype=bool)
-    spans = 0
-    for _ in range(len(pts) + 2):
-        track = np.where(use_linear[:, None], linear, curve)
-        bad = ~polyline_in_mask(track, model.admissible, cell)
-        if not bad.any():
+    if len(pts) < 3:
+        return pts, {"rounded_corners": 0, "sharp_corners": 0}
+    legs = np.linalg.norm(np.diff(pts, axis=0), axis=1)
+    tangent = np.minimum(model.scenario.tracks.smoothing_m, 0.5 * np.minimum(legs[:-1], legs[1:]))
+    samples = 8
+    for attempt in range(7):
+        track = corner_fillets(pts, tangent, samples)
+        ok = polyline_in_mask(track, allowed, cell)
+        # segments of corner i's fillet: the first point of the track is vertex 0, then blocks of samples
+        bad_corner = np.zeros(len(tangent), dtype=bool)
+        seg_owner = np.repeat(np.arange(len(tangent)), np.where(tangent > 0, samples, 1))
+        seg_owner = np.concatenate([[-1], seg_owner])  # segment k ends at point k + 1
+        owner_of_segment = np.maximum(seg_owner[1:], seg_owner[:-1])
+        for k in np.flatnonzero(~ok):
+            if owner_of_segment[k] >= 0:
+                bad_corner[owner_of_segment[k]] = True
+        bad_corner &= tangent > 0
+        if not bad_corner.any():
             break
-        spans += int(np.count_nonzero(np.diff(np.concatenate([[0], bad.astype(int)])) == 1))
-        # widen each bad segment to the enclosing equivalent waypoints and fly the equivalent track there
-        seg = np.flatnonzero(bad)
-        first = np.searchsorted(u, us[seg], side="right") - 1
-        last = np.searchsorted(u, us[seg + 1], side="left")
-        for a, b in zip(u[np.clip(first, 0, len(u) - 1)], u[np.clip(last, 0, len(u) - 1)]):
-            use_linear |= (us >= a) & (us <= b)
-    else:  # pragma: no cover - the equivalent track itself is admissible
-        track = linear
-    return simplify(track, tol=1e-9), {"repaired_spans": spans, "smoothed": True}
+        tangent = np.where(bad_corner, 0.0 if attempt >= 5 else 0.5 * tangent, tangent)
+    track = corner_fillets(pts, tangent, samples)
+    return simplify(track, tol=1e-9), {"rounded_corners": int((tangent > 0).sum()),
+                                       "sharp_corners": int((tangent <= 0).sum())}
 
 
 @dataclass(frozen=True)
@@ -270,7 +308,7 @@ def plan_track(model: PlanningModel, origin, destination, *, backend: str | None
     else:
         stages["equivalent"] = TrackStage(**{**midpoint.__dict__, "seconds": t_mid})
     t0 = time.perf_counter()
-    smoothed, info = smooth_track(model, stages["equivalent"].waypoints)
+    smoothed, info = smooth_track(model, stages["equivalent"].waypoints, corridor=path)
     stages["optimal"] = _stage(model, "optimal", smoothed, time.perf_counter() - t0, **info)
     limit = model.scenario.aircraft.range_m
     if stages["optimal"].length_m > limit:

@@ -24,10 +24,11 @@ from __future__ import annotations
 
 import json
 import math
-from dataclasses import dataclass, field, replace
+from collections.abc import Mapping
+from dataclasses import dataclass, replace
 from functools import cached_property
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Mapping
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -39,6 +40,12 @@ if TYPE_CHECKING:
 
 DEFAULT_SERVICE_S = 3600.0  # T_f − T_s, s: one hour reproduces F = 6 per aircraft (Eq. 23, Table B.3)
 TIME_TOL_S = 1e-6  # slack for float round-off in time comparisons, s
+
+
+def _frozen(array: np.ndarray) -> np.ndarray:
+    """A read-only array: the cached views of a frozen flight set must not be edited in place."""
+    array.setflags(write=False)
+    return array
 
 
 def round_half_up(value: float) -> float:
@@ -103,7 +110,8 @@ class FlightSet:
     """Every flight of the day with the rules that tie them (Eqs. 26-29).
 
     ``flights`` keeps the given order (index i is row i of ``schedule.csv``). Derived arrays
-    (``leg``, ``previous``, ``requires``, ``delay_upper_s``, ...) are computed once, on demand.
+    (``leg``, ``previous``, ``requires``, ``delay_upper_s``, ...) are computed once, on demand, and
+    are read-only.
     """
 
     cell: tuple[float, float, float]  # (Δx, Δy, Δz), m
@@ -135,7 +143,7 @@ class FlightSet:
         for i, f in enumerate(self.flights):
             by_aircraft.setdefault(f.aircraft, []).append(i)
         dep = np.array([f.planned_departure_s for f in self.flights], dtype=float)
-        return tuple(np.array(sorted(ix, key=lambda i: (dep[i], i)), dtype=np.int64) for ix in by_aircraft.values())
+        return tuple(_frozen(np.array(sorted(ix, key=lambda i: (dep[i], i)), dtype=np.int64)) for ix in by_aircraft.values())
 
     @property
     def aircraft_ids(self) -> tuple[str, ...]:
@@ -152,7 +160,7 @@ class FlightSet:
         out = np.zeros(len(self.flights), dtype=np.int64)
         for chain in self.chains:
             out[chain] = np.arange(1, len(chain) + 1)
-        return out
+        return _frozen(out)
 
     @cached_property
     def previous(self) -> np.ndarray:
@@ -160,59 +168,59 @@ class FlightSet:
         out = np.full(len(self.flights), -1, dtype=np.int64)
         for chain in self.chains:
             out[chain[1:]] = chain[:-1]
-        return out
+        return _frozen(out)
 
-    @property
+    @cached_property
     def requires(self) -> np.ndarray:
         """For a return (even leg): the index of its outbound, which it needs operated; else −1.
 
         A cancelled outbound cancels its return: the aircraft never left (MODEL_NOTES).
         """
-        return np.where(self.leg % 2 == 0, self.previous, -1)
+        return _frozen(np.where(self.leg % 2 == 0, self.previous, -1))
 
-    @property
+    @cached_property
     def aircraft_index(self) -> np.ndarray:
         """g: 0-based aircraft number of each flight (order of :attr:`chains`)."""
         out = np.zeros(len(self.flights), dtype=np.int64)
         for g, chain in enumerate(self.chains):
             out[chain] = g
-        return out
+        return _frozen(out)
 
     # --- times --------------------------------------------------------------------------
     @cached_property
     def flight_time_s(self) -> np.ndarray:
-        return np.array([f.flight_time_s for f in self.flights], dtype=float)
+        return _frozen(np.array([f.flight_time_s for f in self.flights], dtype=float))
 
-    @property
+    @cached_property
     def speed_mps(self) -> np.ndarray:
-        return np.array([f.speed_mps for f in self.flights], dtype=float)
+        return _frozen(np.array([f.speed_mps for f in self.flights], dtype=float))
 
-    @property
+    @cached_property
     def planned_departure_s(self) -> np.ndarray:
-        return np.array([f.planned_departure_s for f in self.flights], dtype=float)
+        return _frozen(np.array([f.planned_departure_s for f in self.flights], dtype=float))
 
     @property
     def planned_arrival_s(self) -> np.ndarray:
         return self.planned_departure_s + self.flight_time_s
 
-    @property
+    @cached_property
     def max_delay_s(self) -> np.ndarray:
         """Δd per flight (Eq. 29), s."""
-        return np.array([f.max_delay_s for f in self.flights], dtype=float)
+        return _frozen(np.array([f.max_delay_s for f in self.flights], dtype=float))
 
-    @property
+    @cached_property
     def turnaround_after_s(self) -> np.ndarray:
         """ΔT after each flight (Eq. 28), s."""
-        return np.array([f.turnaround_after_s for f in self.flights], dtype=float)
+        return _frozen(np.array([f.turnaround_after_s for f in self.flights], dtype=float))
 
-    @property
+    @cached_property
     def delay_upper_s(self) -> np.ndarray:
         """Tightest delay bound: min(Δd, T_f − planned arrival) (Eqs. 26, 29), s.
 
         Eq. 26 bounds the last arrival of each aircraft; since an aircraft's flights are in
         sequence, it is the same as every operated flight arriving by T_f.
         """
-        return np.maximum(0.0, np.minimum(self.max_delay_s, self.service_end_s - self.planned_arrival_s))
+        return _frozen(np.maximum(0.0, np.minimum(self.max_delay_s, self.service_end_s - self.planned_arrival_s)))
 
 
 def flight_from_dict(raw: Any, where: str, network: Mapping[str, np.ndarray] | None) -> Flight:
@@ -256,7 +264,7 @@ def flight_from_dict(raw: Any, where: str, network: Mapping[str, np.ndarray] | N
     )
 
 
-def check_flightset(flightset: FlightSet, grid: "AirspaceGrid | None" = None, source: str = "flights.json") -> None:
+def check_flightset(flightset: FlightSet, grid: AirspaceGrid | None = None, source: str = "flights.json") -> None:
     """Validate the rules (STYLE.md: once, at the boundary); raise :class:`InputFileError`.
 
     Checks: unique ids; waypoints inside the grid (when given); planned departure ≥ T_s and
@@ -317,8 +325,8 @@ def _fill_max_delay(flightset: FlightSet) -> FlightSet:
 
 def load_flights(
     path: str | Path,
-    scenario: "Scenario | None" = None,
-    grid: "AirspaceGrid | None" = None,
+    scenario: Scenario | None = None,
+    grid: AirspaceGrid | None = None,
     network: Mapping[str, np.ndarray] | None = None,
 ) -> FlightSet:
     """Read and validate ``flights.json`` (INTERFACES.md).

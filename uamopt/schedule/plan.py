@@ -9,12 +9,20 @@ F flights (Eq. 23) with the turnaround gaps of Eqs. 27-28 taken with equality.
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING, Mapping
+from collections.abc import Mapping
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from uamopt.errors import UamoptError
-from uamopt.schedule.flights import DEFAULT_SERVICE_S, Flight, FlightSet, check_flightset, round_half_up, track_length_m
+from uamopt.schedule.flights import (
+    DEFAULT_SERVICE_S,
+    Flight,
+    FlightSet,
+    check_flightset,
+    round_half_up,
+    track_length_m,
+)
 
 if TYPE_CHECKING:
     from uamopt.grid import AirspaceGrid
@@ -26,7 +34,7 @@ def route_name(origin: str, destination: str) -> str:
     return f"{origin}-{destination}"
 
 
-def scenario_routes(scenario: "Scenario") -> list[tuple[str, str]]:
+def scenario_routes(scenario: Scenario) -> list[tuple[str, str]]:
     """The network's routes (a, b): the scenario's list, or every pair in vertiport order."""
     if scenario.network.routes is not None:
         return [tuple(r) for r in scenario.network.routes]  # type: ignore[misc]
@@ -34,7 +42,7 @@ def scenario_routes(scenario: "Scenario") -> list[tuple[str, str]]:
     return [(a, b) for i, a in enumerate(names) for b in names[i + 1:]]
 
 
-def straight_network(scenario: "Scenario", grid: "AirspaceGrid", *, layer_offset_cells: int = 1) -> dict[str, np.ndarray]:
+def straight_network(scenario: Scenario, grid: AirspaceGrid, *, layer_offset_cells: int = 1) -> dict[str, np.ndarray]:
     """Straight tracks for every route of the network, both directions.
 
     a→b flies at ``network.cruise_altitude_m``; b→a flies ``layer_offset_cells`` cell layers
@@ -80,10 +88,10 @@ def flights_per_aircraft(
     6
     """
     cycle = 2 * round_half_up(track_length_m / speed_mps) + outbound_gap_s + return_gap_s + interference
-    return int(math.floor(service_s / cycle)) * 2
+    return math.floor(service_s / cycle) * 2
 
 
-def grid_vertiports(n: int, extent_m: tuple[float, float], *, margin_m: float = 300.0, seed: int = 0) -> tuple["Vertiport", ...]:
+def grid_vertiports(n: int, extent_m: tuple[float, float], *, margin_m: float = 300.0, seed: int = 0) -> tuple[Vertiport, ...]:
     """``n`` vertiports V1..Vn at seeded random whole-metre points of [margin, extent − margin]².
 
     For benchmarks on larger domains; at least 500 m apart where the domain allows it.
@@ -104,7 +112,7 @@ def grid_vertiports(n: int, extent_m: tuple[float, float], *, margin_m: float = 
 
 
 def generate_plan(
-    scenario: "Scenario",
+    scenario: Scenario,
     network: Mapping[str, np.ndarray],
     seed: int,
     *,
@@ -181,7 +189,7 @@ def generate_plan(
                 f"end after the service end (slack {slack:.1f} s)",
                 "generate_plan", f"use a window ≤ {math.floor(slack)} s or fewer flights per aircraft",
             )
-        steps = int(math.floor(first_departure_window_s / departure_step_s + 1e-9))
+        steps = math.floor(first_departure_window_s / departure_step_s + 1e-9)
         departure = service_start_s + departure_step_s * float(rng.integers(0, steps + 1))
         aircraft_id = f"A{g + 1:0{width}d}"
         for f, ((o, d), t, gap) in enumerate(zip(legs, times, gaps)):

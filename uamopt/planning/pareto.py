@@ -1,0 +1,235 @@
+"""Trade-off between operational risk and transport cost (Sec. 6.3.2, Fig. 21).
+
+Each point is the initial track (A* on Eq. 10 plus the safety buffer μ·R(t) of Eq. 35) for one
+weight pair (ω4, ω5): ω4 weighs the risk cost C_R (Eq. 11), ω5 the transport cost C_T (Eq. 12).
+The front keeps the points no other point beats on both costs.
+
+A weighted sum with a zero weight is ill-posed: with ω5 = 0 every move through safe cells is
+free and A* may return any detour. A zero weight is therefore replaced by a tie-break ε scaled
+to the costs (ε · largest R per metre against ε · c_h per metre), which makes (1, 0) and (0, 1)
+the lexicographic optima: least risk, then least transport, and the reverse.
+
+With ``weights=n`` the sweep starts from those two extremes and then spends the remaining solves
+where the front is still unknown (dichotomic search): for two neighbouring points a and b it
+solves with the weights normal to the segment ab, ω4 ∝ C_T(b) − C_T(a), ω5 ∝ C_R(a) − C_R(b), and
+keeps splitting wherever a new point appears. Without the buffer (``buffer=False``) this finds
+the supported points of the exact bi-objective front; with it, each point is still the optimum
+of its own weighted search, and the points that the buffer term makes dominated are reported
+as such by :func:`non_dominated` and greyed by :func:`plot_pareto`.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import heapq
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from uamopt.planning.problem import PlanningModel
+from uamopt.planning.search import grid_search
+from uamopt.planning.tracks import STAGES, TrackPlan, endpoint_cell, track_metrics
+
+TIE_BREAK = 1e-6  # ε: a zero weight becomes ε times the other objective's per-metre scale
+SAME_COST = 1e-9  # relative tolerance under which two points have the same costs
+
+
+@dataclass(frozen=True)
+class ParetoPoint:
+    """One weighted search: its weights, Eq. 11 and Eq. 12 costs and the cell-centre track."""
+
+    w4: float  # ω4, risk weight actually used (a zero replaced by the tie-break)
+    w5: float  # ω5, transport weight actually used
+    risk_cost: float  # C_R, Eq. 11
+    transport_cost: float  # C_T, Eq. 12, ¥
+    waypoints: np.ndarray  # (n, 3), m: centres of the cells of the optimal path
+
+
+def tie_break_weights(model: PlanningModel) -> tuple[float, float]:
+    """(ε_4, ε_5): the weights that stand in for ω4 = 0 and ω5 = 0.
+
+    ε_5 · c_h per metre is 10⁻⁶ of the largest risk per metre, and ε_4 the reverse, so the
+    stand-in only breaks ties between tracks of equal cost in the other objective.
+    """
+    risky = model.risk[model.admissible]
+    rho = float(risky.max()) if risky.size and risky.max() > 0 else 1.0  # R per metre (Eq. 11)
+    kappa = float(model.c_h)  # ¥ per horizontal metre (Eq. 12)
+    return TIE_BREAK * kappa / rho, TIE_BREAK * rho / kappa
+
+
+def _checked_pair(pair, eps: tuple[float, float]) -> tuple[float, float]:
+    try:
+        w4, w5 = (float(v) for v in pair)
+    except (TypeError, ValueError):
+        raise ValueError(f"weights must be pairs (ω4, ω5) of numbers, got {pair!r}") from None
+    if not (np.isfinite(w4) and np.isfinite(w5)) or w4 < 0 or w5 < 0 or w4 + w5 == 0:
+        raise ValueError(f"weights (ω4, ω5) must be finite, ≥ 0 and not both 0, got {pair!r}")
+    return (w4 if w4 > 0 else eps[0]), (w5 if w5 > 0 else eps[1])
+
+
+def weighted_model(model: PlanningModel, w4: float, w5: float, *, buffer: bool = True) -> PlanningModel:
+    """The model with tracks.weights = (ω4, ω5) (and μ = 0 when ``buffer`` is False); the
+    scenario is copied through :meth:`Scenario.with_overrides`, never mutated."""
+    overrides = [f"tracks.weights=[{float(w4)!r},{float(w5)!r}]"]
+    if not buffer:
+        overrides.append("tracks.buffer_penalty=0.0")
+    return dataclasses.replace(model, scenario=model.scenario.with_overrides(overrides))
+
+
+def _solve(model: PlanningModel, start, goal, w4: float, w5: float, buffer: bool) -> ParetoPoint:
+    weighted = weighted_model(model, w4, w5, buffer=buffer)
+    result = grid_search(weighted.search_problem("initial"), start, goal, backend=model.scenario.tracks.search,
+                         heuristic=model.scenario.tracks.heuristic)
+    waypoints = (result.path + 0.5) * np.asarray(model.field.grid.cell)  # as the initial stage's
+    costs = track_metrics(weighted, waypoints)
+    return ParetoPoint(w4, w5, costs["risk_cost"], costs["transport_cost"], waypoints)
+
+
+def _same(a: ParetoPoint, b: ParetoPoint) -> bool:
+    scale = max(abs(a.risk_cost), abs(b.risk_cost), 1e-300), max(abs(a.transport_cost), abs(b.transport_cost), 1e-300)
+    return (abs(a.risk_cost - b.risk_cost) <= SAME_COST * scale[0]
+            and abs(a.transport_cost - b.transport_cost) <= SAME_COST * scale[1])
+
+
+def weight_sweep(model: PlanningModel, origin, destination, weights: int | Sequence = 9, *,
+                 buffer: bool = True) -> list[ParetoPoint]:
+    """Every weighted search of the sweep, in the order solved (dominated points included).
+
+    Parameters
+    ----------
+    model : PlanningModel
+    origin, destination : (x, y, z), m
+        As for :func:`uamopt.planning.plan_track`; the search runs between their cells.
+    weights : int or sequence of (ω4, ω5)
+        An int n ≥ 2: the two extremes and n − 2 dichotomic solves (module docstring); fewer
+        when the front is complete earlier. A sequence: exactly these pairs, zeros replaced by
+        the tie-break of :func:`tie_break_weights`.
+    buffer : bool
+        Keep the scenario's safety-buffer penalty μ (Eq. 35) in every search; False sets μ = 0,
+        so each search minimises ω4 C_R + ω5 C_T alone.
+
+    Raises
+    ------
+    ValueError
+        ``weights`` is an int below 2, or a pair is negative, not finite or (0, 0).
+    UamoptError, NoTrackError
+        As :func:`plan_track`, for the end points.
+    """
+    start = endpoint_cell(model, np.asarray(origin, dtype=float), "origin")
+    goal = endpoint_cell(model, np.asarray(destination, dtype=float), "destination")
+    eps = tie_break_weights(model)
+    if not isinstance(weights, (int, np.integer)):
+        pairs = [_checked_pair(p, eps) for p in weights]
+        if not pairs:
+            raise ValueError("weights must hold at least one pair (ω4, ω5)")
+        return [_solve(model, start, goal, w4, w5, buffer) for w4, w5 in pairs]
+    if weights < 2:
+        raise ValueError(f"weights must be an int ≥ 2 or a sequence of (ω4, ω5) pairs, got {weights}")
+    cheap = _solve(model, start, goal, eps[0], 1.0, buffer)  # least C_T, then least C_R
+    safe = _solve(model, start, goal, 1.0, eps[1], buffer)  # least C_R, then least C_T
+    points = [cheap, safe]
+    # segments (a, b) with C_T(a) < C_T(b) and C_R(a) > C_R(b), widest first (normalised span)
+    span_r = max(cheap.risk_cost - safe.risk_cost, 1e-300)
+    span_t = max(safe.transport_cost - cheap.transport_cost, 1e-300)
+    queue: list = []
+
+    def push(a: ParetoPoint, b: ParetoPoint) -> None:
+        d_t, d_r = b.transport_cost - a.transport_cost, a.risk_cost - b.risk_cost
+        if d_t > SAME_COST * max(abs(b.transport_cost), 1.0) and d_r > SAME_COST * max(abs(a.risk_cost), 1e-300):
+            heapq.heappush(queue, (-np.hypot(d_t / span_t, d_r / span_r), len(points), a, b))
+
+    push(cheap, safe)
+    while queue and len(points) < weights:
+        _, _, a, b = heapq.heappop(queue)
+        d_t, d_r = b.transport_cost - a.transport_cost, a.risk_cost - b.risk_cost
+        w4, w5 = d_t / (d_t + d_r), d_r / (d_t + d_r)  # normal to ab: a and b cost the same
+        c = _solve(model, start, goal, w4, w5, buffer)
+        if _same(c, a) or _same(c, b) or any(_same(c, p) for p in points):
+            continue
+        points.append(c)
+        if a.transport_cost < c.transport_cost < b.transport_cost and b.risk_cost < c.risk_cost < a.risk_cost:
+            push(a, c)
+            push(c, b)
+    return points
+
+
+def non_dominated(points: Sequence[ParetoPoint]) -> list[ParetoPoint]:
+    """The points no other point beats on both C_R and C_T (both minimised), one per distinct
+    cost pair, sorted by transport cost (then risk cost)."""
+    def below(a: float, b: float) -> bool:  # a < b beyond rounding
+        return a < b - SAME_COST * max(abs(a), abs(b), 1e-300)
+
+    ordered = sorted(points, key=lambda p: (p.transport_cost, p.risk_cost))
+    front: list[ParetoPoint] = []
+    for p in ordered:  # by rising C_T, a point is on the front iff its C_R is below every earlier one
+        if not front or below(p.risk_cost, front[-1].risk_cost):
+            if front and not below(front[-1].transport_cost, p.transport_cost):
+                front[-1] = p  # the same C_T up to rounding and less risk: the earlier one is dominated
+            else:
+                front.append(p)
+    return front
+
+
+def pareto_front(model: PlanningModel, origin, destination, weights: int | Sequence = 9, *,
+                 buffer: bool = True) -> list[ParetoPoint]:
+    """The Pareto front of Fig. 21: non-dominated (C_R, C_T) of the weighted initial tracks.
+
+    Parameters and exceptions as :func:`weight_sweep`. Returns the front sorted by rising
+    transport cost, hence falling risk cost; never empty.
+
+    Examples
+    --------
+    >>> front = pareto_front(model, (300, 300, 120), (2220, 4220, 120), 9)  # doctest: +SKIP
+    >>> [(round(p.transport_cost, 2), round(p.risk_cost)) for p in front]  # doctest: +SKIP
+    """
+    return non_dominated(weight_sweep(model, origin, destination, weights, buffer=buffer))
+
+
+def plot_pareto(points: Sequence[ParetoPoint], path: str | Path, *, plan: TrackPlan | None = None,
+                title: str = "") -> Path:
+    """Draw the trade-off of Fig. 21 and write an 8 × 5.5 in PNG at 130 dpi.
+
+    ``points`` may hold a whole :func:`weight_sweep`: the non-dominated ones form the front
+    (line and markers, labelled with ω5/ω4), the others are greyed. With ``plan``, its four
+    stages (Table 2) are marked in the colours of Fig. 18 for comparison.
+    """
+    from uamopt.plot_tracks import STAGE_STYLE  # the stage colours; a plotting import, kept local
+    from uamopt.plots import DPI
+
+    path = Path(path)
+    if not points:
+        raise ValueError("points must hold at least one ParetoPoint")
+    front = non_dominated(points)
+    on_front = {id(p) for p in front}
+    rest = [p for p in points if id(p) not in on_front]
+    fig = Figure(figsize=(8.0, 5.5), dpi=DPI, layout="constrained")
+    ax = fig.add_subplot()
+    if rest:
+        ax.scatter([p.transport_cost for p in rest], [p.risk_cost for p in rest], s=28, c="0.7",
+                   edgecolors="0.45", linewidths=0.6, zorder=3, label="dominated")
+    ax.plot([p.transport_cost for p in front], [p.risk_cost for p in front], color="#1f4e9c", lw=1.4,
+            marker="o", ms=6, mfc="white", mew=1.4, zorder=4, label=f"Pareto front ({len(front)} track{'s' if len(front) > 1 else ''})")
+    for n, p in enumerate(front):  # labels alternate sides so neighbours do not collide
+        left = n % 2 == 1
+        ax.annotate(f"(ω4, ω5) = ({p.w4:.2g}, {p.w5:.2g})", (p.transport_cost, p.risk_cost),
+                    xytext=(-7 if left else 7, 0), textcoords="offset points", fontsize=6.5, color="#1f4e9c",
+                    va="center", ha="right" if left else "left", zorder=6)
+    if plan is not None:
+        for name, marker in zip(STAGES, "sDPo"):
+            st = plan.stages[name]
+            ax.scatter([st.transport_cost], [st.risk_cost], marker=marker, s=55, c=STAGE_STYLE[name][1],
+                       edgecolors="black", linewidths=0.7, zorder=5, label=f"{name} track (Table 2)")
+    ax.margins(x=0.25, y=0.08)  # room for the weight labels
+    ax.set_xlabel("transport cost C_T (¥, Eq. 12)", fontsize=9)
+    ax.set_ylabel("operational risk cost C_R (Eq. 11)", fontsize=9)
+    ax.tick_params(labelsize=8)
+    ax.grid(color="0.9", lw=0.6)
+    ax.legend(fontsize=7.5, loc="best", framealpha=0.9)
+    head = f"{title} — " if title else ""
+    ax.set_title(f"{head}trade-off between operational risk and transport cost (Fig. 21)", fontsize=10)
+    fig.savefig(path, dpi=DPI)
+    fig.clear()
+    return path

@@ -1,0 +1,268 @@
+"""The scheduling model as data (Sec. 4.3) and the result every solver returns.
+
+A :class:`SchedulingProblem` holds everything a solver needs and nothing it must derive from the
+paper: per flight its planned departure D, flight time, delay bound, turnaround gap and
+predecessors; per conflicting pair the forbidden open intervals of δ = dep_q − dep_p; the
+objective. Decisions: c_f ∈ {0, 1} (operated) and 0 ≤ d_f ≤ ``delay_upper_s[f]``; dep_f = D_f + d_f.
+
+Constraints (MODEL_NOTES, Scheduling):
+
+1. Conflicts: for each pair (p, q, intervals) of ``conflicts`` with c_p = c_q = 1,
+   dep_q − dep_p ∉ (lo, hi) for every row — i.e. δ ≤ lo or δ ≥ hi.
+2. Precedence: c_f ≤ c_{requires[f]} for a return (the aircraft never left without its outbound).
+3. Turnaround (Eq. 27): an operated flight departs at least ΔT after the arrival of the previous
+   *operated* flight of its aircraft. Equivalently, for every earlier flight e of the same
+   aircraft (``chains``): c_e = c_f = 1 ⇒ dep_f ≥ dep_e + flight_time_e + turnaround_after_s[e];
+   the pairs with an operated flight in between are implied, so this all-pairs form is exact.
+4. Service end (Eq. 26) and delay threshold (Eq. 29): 0 ≤ d_f ≤ delay_upper_s[f]
+   = min(Δd_f, T_f − planned arrival_f).
+
+Objective (Eqs. 20-22): ``"weighted"``: W = ω6·Σ_f c_f d_f / G − ω7·Σ_f c_f (minimised);
+``"lexicographic"``: most operated flights first, then least total delay, as the scalar
+−S + Σ c d / (Σ delay_upper + 1) (the delay term lies in [0, 1), so S decides first).
+"""
+
+from __future__ import annotations
+
+import csv
+import itertools
+from dataclasses import dataclass, field
+from functools import cached_property
+from pathlib import Path
+from typing import TYPE_CHECKING, Literal
+
+import numpy as np
+
+from uamopt.errors import UamoptError
+from uamopt.schedule.flights import TIME_TOL_S, FlightSet, save_flights
+from uamopt.schedule.occupancy import ConflictTable, conflict_table
+
+if TYPE_CHECKING:
+    from uamopt.scenario import Scenario
+
+Status = Literal["optimal", "feasible", "time_limit", "infeasible"]
+STATUSES = ("optimal", "feasible", "time_limit", "infeasible")
+ObjectiveKind = Literal["weighted", "lexicographic"]
+
+
+@dataclass(frozen=True, eq=False)
+class SchedulingProblem:
+    """The model (data). Build it with :func:`build_problem`; any solver takes it as it is."""
+
+    flights: FlightSet
+    conflicts: ConflictTable  # a sequence of PairConflict(p, q, intervals); arrays in conflict_arrays
+    weights: tuple[float, float] = (0.6, 0.4)  # (ω6, ω7), Eq. 20
+    aircraft_count: int = 0  # G, Eq. 21: the number of distinct aircraft in ``flights`` (0: fill it in)
+    objective_kind: ObjectiveKind = "weighted"
+
+    def __post_init__(self) -> None:
+        if self.objective_kind not in ("weighted", "lexicographic"):
+            raise UamoptError(f"unknown objective '{self.objective_kind}'", "schedule objective", "use weighted or lexicographic")
+        if self.aircraft_count <= 0:
+            object.__setattr__(self, "aircraft_count", self.flights.n_aircraft)
+
+    @property
+    def n_flights(self) -> int:
+        return len(self.flights)
+
+    # convenient views of the flight set, computed once
+    @cached_property
+    def planned_departure_s(self) -> np.ndarray:
+        return self.flights.planned_departure_s
+
+    @cached_property
+    def flight_time_s(self) -> np.ndarray:
+        return self.flights.flight_time_s
+
+    @cached_property
+    def delay_upper_s(self) -> np.ndarray:
+        """Largest admissible delay of each flight: min(Δd, T_f − planned arrival) (Eqs. 26, 29), s."""
+        return self.flights.delay_upper_s
+
+    @cached_property
+    def turnaround_after_s(self) -> np.ndarray:
+        return self.flights.turnaround_after_s
+
+    @cached_property
+    def requires(self) -> np.ndarray:
+        """Index of the outbound a return needs operated, −1 for outbounds."""
+        return self.flights.requires
+
+    @cached_property
+    def previous(self) -> np.ndarray:
+        return self.flights.previous
+
+    @property
+    def chains(self) -> tuple[np.ndarray, ...]:
+        """Flight indices of each aircraft, in order."""
+        return self.flights.chains
+
+    @property
+    def conflict_arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The conflicts in CSR form: ``pairs`` (m, 2), ``ptr`` (m + 1,), ``intervals`` (K, 2);
+        pair k forbids dep_q − dep_p in the open intervals ``intervals[ptr[k]:ptr[k+1]]``."""
+        c = self.conflicts
+        return np.stack([c.p, c.q], axis=1), c.ptr, c.intervals
+
+
+def build_problem(
+    flightset: FlightSet,
+    scenario: Scenario | None = None,
+    *,
+    weights: tuple[float, float] | None = None,
+    objective: ObjectiveKind = "weighted",
+) -> SchedulingProblem:
+    """Compute the pair conflicts of ``flightset`` and assemble the model.
+
+    ``weights`` default to the scenario's (ω6, ω7) = (0.6, 0.4); G defaults to the number of
+    distinct aircraft in the flight set (INTERFACES.md).
+    """
+    if weights is None:
+        weights = tuple(scenario.schedule.weights) if scenario is not None else (0.6, 0.4)  # type: ignore[assignment]
+    return SchedulingProblem(
+        flights=flightset, conflicts=conflict_table(flightset), weights=tuple(float(w) for w in weights),  # type: ignore[arg-type]
+        aircraft_count=flightset.n_aircraft, objective_kind=objective,
+    )
+
+
+def evaluate(problem: SchedulingProblem, operated: np.ndarray, delay_s: np.ndarray) -> float:
+    """The objective of a decision (feasible or not): Eq. 20 or the lexicographic scalar."""
+    c = np.asarray(operated, dtype=bool)
+    total_delay = float(np.sum(np.where(c, np.asarray(delay_s, dtype=float), 0.0)))
+    flights = int(c.sum())
+    if problem.objective_kind == "lexicographic":
+        return -flights + total_delay / (float(np.sum(problem.delay_upper_s)) + 1.0)
+    w6, w7 = problem.weights
+    return w6 * total_delay / problem.aircraft_count - w7 * flights  # Eqs. 20-22
+
+
+def violations(problem: SchedulingProblem, operated: np.ndarray, delay_s: np.ndarray, tol_s: float = TIME_TOL_S) -> list[str]:
+    """The model's constraints 1-4 that a decision breaks (empty: feasible).
+
+    This checks against the model's own data; ``uamopt verify`` checks written files independently.
+    """
+    c = np.asarray(operated, dtype=bool)
+    d = np.where(c, np.asarray(delay_s, dtype=float), 0.0)
+    ids = [f.id for f in problem.flights.flights]
+    out: list[str] = []
+    for i in np.flatnonzero(c & ((d < -tol_s) | (d > problem.delay_upper_s + tol_s))):
+        out.append(f"flight {ids[i]}: delay {d[i]:g} s outside [0, {problem.delay_upper_s[i]:g}] s")
+    req = problem.requires
+    for i in np.flatnonzero(c & (req >= 0)):
+        if not c[req[i]]:
+            out.append(f"flight {ids[i]}: return operated without its outbound {ids[req[i]]}")
+    dep = problem.planned_departure_s + d
+    arr = dep + problem.flight_time_s
+    for chain in problem.chains:
+        flown = chain[c[chain]]
+        for e, f in itertools.pairwise(flown):
+            if dep[f] < arr[e] + problem.turnaround_after_s[e] - tol_s:
+                out.append(f"flight {ids[f]}: departs {dep[f]:.3f} s, before {ids[e]}'s arrival + turnaround "
+                           f"{arr[e] + problem.turnaround_after_s[e]:.3f} s")
+    pairs, ptr, intervals = problem.conflict_arrays
+    pair_of_row = np.repeat(np.arange(len(pairs)), np.diff(ptr))
+    p, q = pairs[pair_of_row, 0], pairs[pair_of_row, 1]
+    delta = dep[q] - dep[p]
+    bad = c[p] & c[q] & (intervals[:, 0] + tol_s < delta) & (delta < intervals[:, 1] - tol_s)
+    for row in np.flatnonzero(bad):
+        out.append(f"flights {ids[p[row]]} and {ids[q[row]]}: departure gap {delta[row]:.3f} s in forbidden "
+                   f"({intervals[row, 0]:.3f}, {intervals[row, 1]:.3f})")
+    return out
+
+
+@dataclass(frozen=True, eq=False)
+class Schedule:
+    """What every solver returns (linopy-style result): decisions, status, objective, bound."""
+
+    solver: str
+    status: Status
+    operated: np.ndarray  # c_f, bool (n,)
+    delay_s: np.ndarray  # d_f, s (n,); 0 for cancelled flights
+    objective: float | None
+    bound: float | None = None
+    gap: float | None = None
+    solve_seconds: float = 0.0
+    seed: int | None = None
+    aircraft_count: int = 1  # G, for Eq. 21
+    extras: dict = field(default_factory=dict)  # solver-specific figures (iterations, nodes, ...)
+
+    def __post_init__(self) -> None:
+        if self.status not in STATUSES:
+            raise UamoptError(f"unknown status '{self.status}'", f"solver {self.solver}", f"use one of {', '.join(STATUSES)}")
+
+    @property
+    def operated_count(self) -> int:
+        """S (Eq. 22)."""
+        return int(np.sum(self.operated))
+
+    @property
+    def cancelled(self) -> int:
+        return int(len(self.operated) - self.operated_count)
+
+    @property
+    def total_delay_s(self) -> float:
+        return float(np.sum(np.where(self.operated, self.delay_s, 0.0)))
+
+    @property
+    def avg_delay_s(self) -> float:
+        """T_d = total delay of operated flights / G (Eq. 21)."""
+        return self.total_delay_s / self.aircraft_count
+
+    def summary(self) -> dict:
+        """The keys of summary.json (INTERFACES.md)."""
+        return {
+            "solver": self.solver, "status": self.status, "objective": self.objective, "bound": self.bound,
+            "gap": self.gap, "operated": self.operated_count, "cancelled": self.cancelled,
+            "total_delay_s": self.total_delay_s, "avg_delay_s": self.avg_delay_s,
+            "solve_seconds": self.solve_seconds, "seed": self.seed,
+        }
+
+
+def make_schedule(
+    problem: SchedulingProblem, solver: str, status: Status, operated: np.ndarray, delay_s: np.ndarray, *,
+    bound: float | None = None, solve_seconds: float = 0.0, seed: int | None = None, extras: dict | None = None,
+) -> Schedule:
+    """A :class:`Schedule` with the objective evaluated and the relative gap |obj − bound| / |obj|."""
+    c = np.asarray(operated, dtype=bool).copy()
+    d = np.where(c, np.asarray(delay_s, dtype=float), 0.0)
+    objective = evaluate(problem, c, d) if status != "infeasible" else None
+    gap = None
+    if objective is not None and bound is not None:
+        gap = abs(objective - bound) / max(abs(objective), 1e-10)
+    return Schedule(solver=solver, status=status, operated=c, delay_s=d, objective=objective, bound=bound, gap=gap,
+                    solve_seconds=solve_seconds, seed=seed, aircraft_count=problem.aircraft_count, extras=dict(extras or {}))
+
+
+def _fmt(value: float) -> str:
+    return repr(float(value))
+
+
+def write_schedule(out_dir: str | Path, problem: SchedulingProblem, schedule: Schedule) -> None:
+    """Write flights.json, schedule.csv and summary.json into ``out_dir``, all or nothing.
+
+    ``schedule.csv``: flight, aircraft, route, operated (1/0), planned_departure_s, delay_s,
+    departure_s, arrival_s; a cancelled flight has delay 0 and empty departure and arrival.
+    ``summary.json`` carries the INTERFACES.md keys plus ``weights``, ``objective_kind``,
+    ``aircraft`` (G) and ``flights`` so the verifier can recompute the objective.
+    """
+    from uamopt.outputs import staged_output, write_json
+
+    fs = problem.flights
+    dep = problem.planned_departure_s + schedule.delay_s
+    arr = dep + problem.flight_time_s
+    summary = schedule.summary() | {
+        "weights": list(problem.weights), "objective_kind": problem.objective_kind,
+        "aircraft": problem.aircraft_count, "flights": problem.n_flights,
+    }
+    with staged_output(out_dir) as stage:
+        save_flights(stage / "flights.json", fs)
+        with open(stage / "schedule.csv", "w", newline="", encoding="utf-8") as fh:
+            writer = csv.writer(fh)
+            writer.writerow(["flight", "aircraft", "route", "operated", "planned_departure_s", "delay_s", "departure_s", "arrival_s"])
+            for i, f in enumerate(fs.flights):
+                on = bool(schedule.operated[i])
+                writer.writerow([
+                    f.id, f.aircraft, f.route, int(on), _fmt(f.planned_departure_s), _fmt(schedule.delay_s[i] if on else 0.0),
+                    _fmt(dep[i]) if on else "", _fmt(arr[i]) if on else "",
+                ])
+        write_json(stage / "summary.json", summary)

@@ -1,0 +1,310 @@
+"""Exact cell occupancy of tracks and the forbidden departure gaps of flight pairs (Sec. 4.3, 5.2.1).
+
+Occupancy
+---------
+A flight flies its piecewise-linear track at constant speed v_g from its departure, with no
+holding (MODEL_NOTES). Its position is linear in time between consecutive *breakpoints*: the
+waypoint times and the instants where the track crosses any x, y or z grid plane. Between two
+breakpoints it stays in one cell, found from the position at the middle of the interval. The
+breakpoints are computed for all segments and planes at once (numpy, no loop over cells).
+
+Conventions
+~~~~~~~~~~~
+- Cells are indexed by floor(x/Δx), floor(y/Δy), floor(z/Δz) with no clipping, so a track that
+  runs *inside* a grid plane for a positive time (the paper case flies at z = 120 m = 4Δz) is in
+  the cell above that plane, as ``AirspaceGrid.indices_of`` puts points on a face in the upper
+  cell. A single instant on a plane has no duration and does not matter (see conflicts below).
+- Breakpoints closer than ``MERGE_TOL_S`` are merged, so a track through an edge or a corner
+  of the grid (exactly, or up to float round-off) passes from cell to cell without a spurious
+  visit of zero length to a neighbour. Visits shorter than that are physically meaningless.
+- Times are relative to departure; the visits tile [0, flight time] exactly.
+
+Conflicts and forbidden gaps
+----------------------------
+Two operated flights p, q of different aircraft conflict when they occupy cells whose indices
+differ by at most r in every axis (r = 1: the 3×3×3 zone of Sec. 5.2.1; r = 0: Eq. 24's same
+cell) during overlapping times of *positive length*. Cell c is occupied by p during
+[a_p, b_p] + dep_p and a cell within r of c by q during [a_q, b_q] + dep_q; these overlap for a
+positive time iff  a_p + dep_p < b_q + dep_q  and  a_q + dep_q < b_p + dep_p, that is iff
+
+    δ = dep_q − dep_p ∈ (a_p − b_q,  b_p − a_q)        (an open interval).
+
+So each pair's constraint is: δ avoids the union of these open intervals over all near pairs of
+visits; touching (q entering as p leaves) is not a conflict. This reads Eq. 24's strict
+T_in > T_out as "no overlap of positive length", the only reading that does not depend on how
+an instant on a cell face is assigned; the verifier uses the same rule with a tolerance of
+``TIME_TOL_S``. Intervals whose gap is below ``TIME_TOL_S`` are merged (conservative).
+
+Speed-up: flights with the same track and speed share one occupancy; for each ordered pair of
+such *tracks* the intervals are computed once with a sort-merge join on dilated cell codes; then
+the flight pairs whose departure windows can meet are matched to their track pair's intervals.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from uamopt.schedule.flights import TIME_TOL_S, FlightSet
+
+MERGE_TOL_S = 1e-9  # breakpoints closer than this are one instant, s
+
+
+@dataclass(frozen=True, eq=False)
+class Occupancy:
+    """Cell visits of one track, in time order: ``cells`` (m, 3) int64 (i, j, k) and the entry
+    and exit times ``t_in``, ``t_out`` (m,) relative to departure, s."""
+
+    cells: np.ndarray
+    t_in: np.ndarray
+    t_out: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.t_in)
+
+
+@dataclass(frozen=True, eq=False)
+class PairConflict:
+    """Flights ``p`` < ``q`` (indices into the flight set) conflict iff dep_q − dep_p lies in one
+    of ``intervals`` (m, 2): sorted, disjoint, open intervals (lo, hi), s. Only intervals that
+    meet the pair's feasible range of δ are kept."""
+
+    p: int
+    q: int
+    intervals: np.ndarray
+
+
+def track_occupancy(waypoints: np.ndarray, speed_mps: float, cell: tuple[float, float, float]) -> Occupancy:
+    """Entry and exit time of every cell a track passes through, flown at ``speed_mps`` from t = 0.
+
+    Parameters
+    ----------
+    waypoints : ndarray (n, 3)
+        Track, m. Repeated consecutive points are ignored.
+    speed_mps : float
+        v_g, m/s.
+    cell : (Δx, Δy, Δz)
+        Cell size, m.
+
+    Examples
+    --------
+    >>> occ = track_occupancy(np.array([[5.0, 5, 5], [25.0, 5, 5]]), 10.0, (10.0, 10.0, 10.0))
+    >>> occ.cells.tolist(), occ.t_in.tolist(), occ.t_out.tolist()
+    ([[0, 0, 0], [1, 0, 0], [2, 0, 0]], [0.0, 0.5, 1.5], [0.5, 1.5, 2.0])
+    """
+    pts = np.asarray(waypoints, dtype=float)
+    keep = np.ones(len(pts), dtype=bool)
+    keep[1:] = np.any(np.diff(pts, axis=0) != 0, axis=1)
+    pts = pts[keep]
+    size = np.asarray(cell, dtype=float)
+    seg_len = np.linalg.norm(np.diff(pts, axis=0), axis=1)
+    t_vertex = np.concatenate([[0.0], np.cumsum(seg_len)]) / speed_mps  # Eq. 31
+    p0, p1 = pts[:-1], pts[1:]
+    t0, dt = t_vertex[:-1], np.diff(t_vertex)
+    times = [t_vertex]
+    for axis in range(3):
+        # planes m·Δ strictly between the two ends of each segment
+        lo_c = np.minimum(p0[:, axis], p1[:, axis]) / size[axis]
+        hi_c = np.maximum(p0[:, axis], p1[:, axis]) / size[axis]
+        first = np.floor(lo_c).astype(np.int64) + 1
+        count = np.maximum(np.ceil(hi_c).astype(np.int64) - first, 0)
+        if count.sum() == 0:
+            continue
+        seg = np.repeat(np.arange(len(count)), count)
+        m = first[seg] + np.arange(count.sum()) - np.repeat(np.cumsum(count) - count, count)
+        frac = (m * size[axis] - p0[seg, axis]) / (p1[seg, axis] - p0[seg, axis])
+        times.append(t0[seg] + frac * dt[seg])
+    t = np.sort(np.concatenate(times))
+    t = t[np.concatenate([[True], np.diff(t) > MERGE_TOL_S])]
+    t = t if len(t) > 1 else np.array([0.0, t_vertex[-1]])  # a track shorter than MERGE_TOL_S
+    t[-1] = t_vertex[-1]
+    mid = 0.5 * (t[:-1] + t[1:])
+    pos = np.stack([np.interp(mid, t_vertex, pts[:, a]) for a in range(3)], axis=1)
+    cells = np.floor(pos / size).astype(np.int64)
+    new = np.concatenate([[True], np.any(cells[1:] != cells[:-1], axis=1)])
+    start = np.flatnonzero(new)
+    t_out = np.append(t[start[1:]], t[-1])
+    return Occupancy(cells=cells[start], t_in=t[start], t_out=t_out)
+
+
+def flight_occupancies(flightset: FlightSet) -> tuple[list[Occupancy], np.ndarray]:
+    """Occupancy of every flight, shared by flights with the same track and speed.
+
+    Returns ``(occupancies, key)``: one :class:`Occupancy` per distinct (track, speed), and for
+    each flight the index of its occupancy.
+    """
+    index: dict[tuple[bytes, float], int] = {}
+    occupancies: list[Occupancy] = []
+    key = np.empty(len(flightset), dtype=np.int64)
+    for i, f in enumerate(flightset.flights):
+        k = (np.ascontiguousarray(f.waypoints, dtype=float).tobytes(), float(f.speed_mps))
+        if k not in index:
+            index[k] = len(occupancies)
+            occupancies.append(track_occupancy(f.waypoints, f.speed_mps, flightset.cell))
+        key[i] = index[k]
+    return occupancies, key
+
+
+def _group_merge(group: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Union of open intervals per group: returns (group, lo, hi) sorted, disjoint per group.
+
+    Intervals closer than ``TIME_TOL_S`` are merged (conservative: a gap that thin is forbidden).
+    """
+    order = np.lexsort((lo, group))
+    group, lo, hi = group[order], lo[order], hi[order]
+    # running max of hi within each group: offset each group above the previous one
+    rank = np.concatenate([[0], np.cumsum(group[1:] != group[:-1])])
+    span = float(np.max(hi) - np.min(lo)) + 1.0
+    base = float(np.min(lo))
+    run = np.maximum.accumulate((hi - base) + rank * span) - rank * span + base
+    start = np.ones(len(lo), dtype=bool)
+    start[1:] = (rank[1:] != rank[:-1]) | (lo[1:] >= run[:-1] + TIME_TOL_S)
+    idx = np.flatnonzero(start)
+    return group[idx], lo[idx], np.maximum.reduceat(hi, idx)
+
+
+def track_pair_gaps(occupancies: list[Occupancy], radius: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Forbidden δ = dep_q − dep_p for every ordered pair of tracks (A for p, B for q).
+
+    Returns ``(pair_code, ptr, lo, hi)``: ``pair_code`` = A·K + B (sorted, only pairs with a
+    conflict), the intervals of pair ``pair_code[g]`` are ``lo[ptr[g]:ptr[g+1]]``, ``hi[...]``.
+    Visits are joined on cell codes: each visit is dilated to its (2r+1)³ neighbours and matched
+    against all visits by binary search on the sorted codes.
+    """
+    n_keys = len(occupancies)
+    cells = np.concatenate([o.cells for o in occupancies])
+    t_in = np.concatenate([o.t_in for o in occupancies])
+    t_out = np.concatenate([o.t_out for o in occupancies])
+    owner = np.repeat(np.arange(n_keys), [len(o) for o in occupancies])
+    shift = cells.min(axis=0) - radius
+    dims = cells.max(axis=0) - shift + radius + 1
+    c = cells - shift
+    code = (c[:, 0] * dims[1] + c[:, 1]) * dims[2] + c[:, 2]
+    order = np.argsort(code, kind="stable")
+    sorted_code = code[order]
+    r = np.arange(-radius, radius + 1)
+    offsets = ((r[:, None, None] * dims[1] + r[None, :, None]) * dims[2] + r[None, None, :]).ravel()
+    pairs_base, pairs_dil = [], []
+    for off in offsets:  # (2r+1)³ passes, each vectorised over all visits
+        probe = code + off
+        first = np.searchsorted(sorted_code, probe, side="left")
+        count = np.searchsorted(sorted_code, probe, side="right") - first
+        hit = np.flatnonzero(count)
+        if len(hit) == 0:
+            continue
+        reps = count[hit]
+        dil = np.repeat(hit, reps)
+        pos = np.repeat(first[hit] - (np.cumsum(reps) - reps), reps) + np.arange(reps.sum())
+        pairs_base.append(order[pos])
+        pairs_dil.append(dil)
+    if not pairs_base:
+        empty = np.zeros(0)
+        return np.zeros(0, dtype=np.int64), np.zeros(1, dtype=np.int64), empty, empty
+    base = np.concatenate(pairs_base)  # visit of p (track A)
+    dil = np.concatenate(pairs_dil)  # visit of q (track B), within r of p's cell
+    group = owner[base] * n_keys + owner[dil]
+    g, lo, hi = _group_merge(group, t_in[base] - t_out[dil], t_out[base] - t_in[dil])
+    pair_code, starts = np.unique(g, return_index=True)
+    return pair_code, np.append(starts, len(g)).astype(np.int64), lo, hi
+
+
+def candidate_pairs(flightset: FlightSet) -> tuple[np.ndarray, np.ndarray]:
+    """Flight pairs (p < q, different aircraft) whose possible flying windows
+    [D, D + Δd_upper + flight time] overlap; only those can ever conflict."""
+    start = flightset.planned_departure_s
+    end = start + flightset.delay_upper_s + flightset.flight_time_s
+    order = np.argsort(start, kind="stable")
+    s_sorted = start[order]
+    stop = np.searchsorted(s_sorted, end[order], side="left")
+    count = np.maximum(stop - np.arange(len(order)) - 1, 0)
+    a = np.repeat(np.arange(len(order)), count)
+    b = np.repeat(np.cumsum(count) - count, count)
+    b = np.arange(count.sum()) - b + a + 1
+    p, q = order[a], order[b]
+    p, q = np.minimum(p, q), np.maximum(p, q)
+    ac = flightset.aircraft_index
+    keep = ac[p] != ac[q]  # one aircraft's own flights are kept apart by the turnaround rule
+    return p[keep], q[keep]
+
+
+def conflict_table(flightset: FlightSet) -> ConflictTable:
+    """Every flight pair that can conflict, with its forbidden open intervals of δ = dep_q − dep_p,
+    as arrays (the vectorised core of :func:`forbidden_gaps`).
+
+    A pair is kept when one of its intervals meets the feasible range of δ,
+    [D_q − D_p − Δd_p, D_q − D_p + Δd_q] with Δd the delay bound tightened by T_f
+    (``FlightSet.delay_upper_s``); only those intervals are stored, widened to any interval within
+    ``TIME_TOL_S`` of the range (conservative). Pairs of flights of the same aircraft are left out:
+    the turnaround rule already keeps them apart in time.
+    """
+    occupancies, key = flight_occupancies(flightset)
+    pair_code, ptr, lo, hi = track_pair_gaps(occupancies, flightset.conflict_radius)
+    p, q = candidate_pairs(flightset)
+    if len(p) == 0 or len(pair_code) == 0:
+        return ConflictTable.empty()
+    code = key[p] * len(occupancies) + key[q]
+    pos = np.minimum(np.searchsorted(pair_code, code), len(pair_code) - 1)
+    found = pair_code[pos] == code
+    p, q, grp = p[found], q[found], pos[found]
+    dep, upper = flightset.planned_departure_s, flightset.delay_upper_s
+    range_lo = dep[q] - dep[p] - upper[p] - TIME_TOL_S
+    range_hi = dep[q] - dep[p] + upper[q] + TIME_TOL_S
+    # One sorted key per interval: group·span + value. Groups occupy disjoint stretches, so one
+    # searchsorted finds, within each pair's group, the first interval with hi > range_lo and the
+    # first with lo ≥ range_hi (intervals are sorted and disjoint). Float round-off of the key
+    # (< 1e-7 s for 10⁵ groups) is below the TIME_TOL_S widening, so nothing is lost.
+    base, top = float(lo.min()), float(hi.max())
+    span = top - base + 4.0
+    group_of = np.repeat(np.arange(len(pair_code)), np.diff(ptr)) * span
+    key_lo, key_hi = group_of + (lo - base), group_of + (hi - base)
+    offset = grp * span - base
+    first = np.searchsorted(key_hi, offset + np.clip(range_lo, base - 1.0, top + 1.0), side="right")
+    last = np.searchsorted(key_lo, offset + np.clip(range_hi, base - 1.0, top + 1.0), side="left")
+    meet = last > first
+    p, q, first, last = p[meet], q[meet], first[meet], last[meet]
+    order = np.lexsort((q, p))
+    p, q, first, last = p[order], q[order], first[order], last[order]
+    count = last - first
+    rows = np.repeat(first - np.cumsum(count) + count, count) + np.arange(count.sum())
+    return ConflictTable(p=p, q=q, ptr=np.concatenate([[0], np.cumsum(count)]).astype(np.int64),
+                         intervals=np.stack([lo[rows], hi[rows]], axis=1))
+
+
+@dataclass(frozen=True, eq=False)
+class ConflictTable:
+    """All pair conflicts in compressed form; a sequence of :class:`PairConflict` on access.
+
+    Pair k: flights ``p[k]`` < ``q[k]`` must keep dep_q − dep_p out of the open intervals
+    ``intervals[ptr[k]:ptr[k+1]]`` (sorted, disjoint), s. Sorted by (p, q).
+    """
+
+    p: np.ndarray
+    q: np.ndarray
+    ptr: np.ndarray
+    intervals: np.ndarray
+
+    @classmethod
+    def empty(cls) -> ConflictTable:
+        none = np.zeros(0, dtype=np.int64)
+        return cls(p=none, q=none, ptr=np.zeros(1, dtype=np.int64), intervals=np.zeros((0, 2)))
+
+    def __len__(self) -> int:
+        return len(self.p)
+
+    def __getitem__(self, k: int) -> PairConflict:
+        if not -len(self) <= k < len(self):
+            raise IndexError(k)
+        k = k % len(self)
+        return PairConflict(int(self.p[k]), int(self.q[k]), self.intervals[self.ptr[k]:self.ptr[k + 1]])
+
+    def __iter__(self):
+        return (self[k] for k in range(len(self)))
+
+
+def forbidden_gaps(flightset: FlightSet) -> list[PairConflict]:
+    """Every flight pair that can conflict, with its forbidden open intervals of δ = dep_q − dep_p.
+
+    See :func:`conflict_table` (the same data as arrays, much faster for 10⁵+ pairs).
+    """
+    return list(conflict_table(flightset))

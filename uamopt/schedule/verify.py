@@ -1,0 +1,328 @@
+"""The independent verifier behind ``uamopt verify DIR``.
+
+It reads ``DIR/flights.json`` and ``DIR/schedule.csv`` (and ``DIR/summary.json`` when present)
+and checks the schedule against the rules of MODEL_NOTES, sharing no code with the model: its own
+file reading (json, csv), its own occupancy by a different algorithm (a 3-D digital differential
+analyser that walks each segment cell by cell in plain Python, Amanatides & Woo 1987, instead of
+the model's vectorised sort of all plane-crossing times) and its own conflict search (a hash of
+(block of cells, time bucket) instead of the model's forbidden departure gaps).
+
+Rules checked (tolerance ``TOL_S`` = 1e-6 s on every time):
+
+- each flight of flights.json appears once in schedule.csv with the same aircraft, route and
+  planned departure; departure = planned + delay; arrival = departure + length / speed (Eq. 31);
+- 0 ≤ delay ≤ max_delay_s (Eq. 29) and arrival ≤ service end (Eq. 26);
+- a return (even leg of its aircraft) is not operated without its outbound;
+- an operated flight departs ≥ the previous operated flight's arrival + ΔT (Eqs. 27-28:
+  T_D after an odd leg, T_R after an even leg);
+- no two operated flights of different aircraft occupy cells within ``conflict_radius`` in every
+  axis during overlapping times of more than ``TOL_S`` (touching is not a conflict);
+- summary.json's counts, delays and (when its weights are given) objective agree.
+
+Cell convention (shared by definition with the model, not by code): cell = floor(coordinate / Δ);
+when a segment starts exactly on a plane and moves down that axis it is in the lower cell; a
+segment lying in a plane is in the upper cell. Visits shorter than 1e-9 s are dropped.
+"""
+
+from __future__ import annotations
+
+import csv
+import itertools
+import json
+import math
+from collections import defaultdict
+from pathlib import Path
+
+from uamopt.errors import InputFileError
+
+TOL_S = 1e-6  # s
+TIE_S = 1e-9  # crossings closer than this are simultaneous, s
+BUCKET_S = 30.0  # time bucket of the conflict hash, s
+BLOCK = 3  # cells per axis in a block of the conflict hash (≥ r)
+COLUMNS = ["flight", "aircraft", "route", "operated", "planned_departure_s", "delay_s", "departure_s", "arrival_s"]
+
+
+def _next_crossing(p0, d, dur: float, idx: list[int], step: list[int], cell, a: int) -> float:
+    """Time since the segment start at which it leaves cell ``idx`` through a plane of axis ``a``."""
+    if step[a] == 0:
+        return math.inf
+    plane = (idx[a] + 1) * cell[a] if step[a] > 0 else idx[a] * cell[a]
+    return (plane - p0[a]) / d[a] * dur
+
+
+def cell_visits(waypoints, speed_mps: float, cell) -> list[tuple[tuple[int, int, int], float, float]]:
+    """(cell, t_in, t_out) of every cell a track passes through at constant speed from t = 0.
+
+    Walks each segment cell by cell: per axis, the time of the next plane crossing; step the
+    axis (or axes, on a tie) that crosses first.
+    """
+    raw: list[tuple[tuple[int, int, int], float, float]] = []
+    t = 0.0
+    for p0, p1 in itertools.pairwise(waypoints):
+        d = [p1[a] - p0[a] for a in range(3)]
+        length = math.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
+        if length == 0.0:
+            continue
+        dur = length / speed_mps
+        idx, step = [0, 0, 0], [0, 0, 0]
+        for a in range(3):
+            s = p0[a] / cell[a]
+            if d[a] < 0:
+                idx[a], step[a] = math.ceil(s) - 1, -1
+            else:
+                idx[a], step[a] = math.floor(s), (1 if d[a] > 0 else 0)
+
+        nxt = [_next_crossing(p0, d, dur, idx, step, cell, a) for a in range(3)]
+        u = 0.0
+        while True:
+            first = min(nxt)
+            if first >= dur - TIE_S:
+                raw.append(((idx[0], idx[1], idx[2]), t + u, t + dur))
+                break
+            raw.append(((idx[0], idx[1], idx[2]), t + u, t + first))
+            for a in range(3):
+                if nxt[a] <= first + TIE_S:
+                    idx[a] += step[a]
+                    nxt[a] = _next_crossing(p0, d, dur, idx, step, cell, a)
+            u = first
+        t += dur
+    kept = [v for v in raw if v[2] - v[1] > TIE_S]
+    visits: list[tuple[tuple[int, int, int], float, float]] = []
+    for c, _, b in kept:
+        start = visits[-1][2] if visits else 0.0
+        if visits and visits[-1][0] == c:
+            visits[-1] = (c, visits[-1][1], b)
+        else:
+            visits.append((c, start, b))
+    return visits
+
+
+def _number(value, what: str, where: str) -> float:
+    try:
+        out = float(value)
+    except (TypeError, ValueError):
+        raise InputFileError(f"{what} is not a number: {value!r}", where, "rewrite the file with uamopt schedule") from None
+    if not math.isfinite(out):
+        raise InputFileError(f"{what} is not finite: {value!r}", where, "rewrite the file with uamopt schedule")
+    return out
+
+
+def _read_flights(path: Path) -> dict:
+    if not path.is_file():
+        raise InputFileError(f"missing {path.name}", str(path.parent), "give a folder written by uamopt schedule")
+    try:
+        raw = json.loads(path.read_text(encoding="utf-8"))
+        flights = raw["flights"]
+        cell = [float(c) for c in raw["cell"]]
+    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        raise InputFileError(f"malformed JSON: {exc}", str(path), "rewrite the file with uamopt schedule") from None
+    except (KeyError, TypeError, ValueError):
+        raise InputFileError("missing or malformed 'flights' or 'cell'", str(path), "rewrite the file with uamopt schedule") from None
+    out = {
+        "cell": cell, "radius": int(raw.get("conflict_radius", 1)), "flights": [],
+        "service_end_s": _number(raw.get("service_end_s", 3600.0), "service_end_s", str(path)),
+        "gaps": (_number(raw.get("outbound_gap_s", 240.0), "outbound_gap_s", str(path)),
+                 _number(raw.get("return_gap_s", 360.0), "return_gap_s", str(path))),
+    }
+    for f in flights:
+        where = f"{path}: flight {f.get('id') if isinstance(f, dict) else '?'}"
+        if not isinstance(f, dict) or "waypoints" not in f:
+            raise InputFileError("flight without waypoints", where, "the verifier needs self-contained flights (uamopt schedule writes them)")
+        try:
+            wps = [tuple(float(v) for v in p) for p in f["waypoints"]]
+            rec = {
+                "id": str(f["id"]), "aircraft": str(f["aircraft"]), "route": str(f["route"]),
+                "speed": _number(f["speed_mps"], "speed_mps", where),
+                "planned": _number(f["planned_departure_s"], "planned_departure_s", where),
+                "max_delay": _number(f["max_delay_s"], "max_delay_s", where), "waypoints": wps,
+            }
+        except (KeyError, TypeError, ValueError) as exc:
+            raise InputFileError(f"missing or malformed key {exc}", where, "rewrite the file with uamopt schedule") from None
+        if len(wps) < 2 or any(len(p) != 3 for p in wps) or rec["speed"] <= 0:
+            raise InputFileError("waypoints or speed invalid", where, "rewrite the file with uamopt schedule")
+        rec["length"] = sum(math.dist(a, b) for a, b in itertools.pairwise(wps))
+        out["flights"].append(rec)
+    return out
+
+
+def _read_schedule(path: Path) -> dict[str, dict]:
+    if not path.is_file():
+        raise InputFileError(f"missing {path.name}", str(path.parent), "give a folder written by uamopt schedule")
+    rows: dict[str, dict] = {}
+    with open(path, newline="", encoding="utf-8") as fh:
+        reader = csv.DictReader(fh)
+        if reader.fieldnames is None or any(c not in reader.fieldnames for c in COLUMNS):
+            raise InputFileError(f"schedule.csv needs the columns {','.join(COLUMNS)}", str(path), "rewrite it with uamopt schedule")
+        for n, row in enumerate(reader, start=2):
+            where = f"{path}: line {n}"
+            flag = row["operated"].strip().lower()
+            if flag not in ("1", "0", "true", "false"):
+                raise InputFileError(f"operated must be 1 or 0, got {row['operated']!r}", where, "rewrite it with uamopt schedule")
+            on = flag in ("1", "true")
+            rec = {"row": row, "operated": on, "duplicate": row["flight"] in rows,
+                   "planned": _number(row["planned_departure_s"], "planned_departure_s", where),
+                   "delay": _number(row["delay_s"] or 0.0, "delay_s", where)}
+            if on:
+                rec["departure"] = _number(row["departure_s"], "departure_s", where)
+                rec["arrival"] = _number(row["arrival_s"], "arrival_s", where)
+            rows.setdefault(row["flight"], rec)
+            if rec["duplicate"]:
+                rows[row["flight"]]["duplicate"] = True
+    return rows
+
+
+def _conflicts(flights: list[dict], cell, radius: int) -> list[str]:
+    """Conflicts among the given (operated) flights, via a hash of (block of cells, time bucket).
+
+    A block is ``BLOCK`` cells per axis (≥ r), so cells within r of each other lie in the same or
+    adjacent blocks; each unordered pair of neighbouring keys is visited once (half the offsets),
+    and every candidate pair of visits is tested exactly: Chebyshev distance of the cells ≤ r
+    and an overlap in time longer than ``TOL_S``.
+    """
+    block = max(1, radius, BLOCK)
+    cache: dict = {}
+    table: dict[tuple, list] = defaultdict(list)
+    for n, f in enumerate(flights):
+        key = (tuple(f["waypoints"]), f["speed"])
+        if key not in cache:
+            cache[key] = cell_visits(f["waypoints"], f["speed"], cell)
+        for c, a, b in cache[key]:
+            a, b = f["departure"] + a, f["departure"] + b
+            home = (c[0] // block, c[1] // block, c[2] // block)
+            for bucket in range(math.floor(a / BUCKET_S), math.floor(b / BUCKET_S) + 1):
+                table[home + (bucket,)].append((n, a, b, c))
+    reach = 1 if radius > 0 else 0
+    offsets = [o for o in itertools.product(range(-reach, reach + 1), repeat=3) if o > (0, 0, 0)]
+    worst: dict[tuple[int, int], tuple] = {}
+
+    def compare(entries, others, same_key):
+        for n1, a1, b1, c1 in entries:
+            for n2, a2, b2, c2 in others:
+                if n1 == n2 or (same_key and n1 > n2):
+                    continue
+                overlap = min(b1, b2) - max(a1, a2)
+                if overlap <= TOL_S or flights[n1]["aircraft"] == flights[n2]["aircraft"]:
+                    continue
+                if max(abs(c1[0] - c2[0]), abs(c1[1] - c2[1]), abs(c1[2] - c2[2])) > radius:
+                    continue
+                pair, info = ((n1, n2), (overlap, c1, c2)) if n1 < n2 else ((n2, n1), (overlap, c2, c1))
+                if overlap > worst.get(pair, (0.0,))[0]:
+                    worst[pair] = info + (max(a1, a2), min(b1, b2))
+
+    for (i, j, k, bucket), entries in table.items():
+        compare(entries, entries, True)
+        for o in offsets:
+            others = table.get((i + o[0], j + o[1], k + o[2], bucket))
+            if others:
+                compare(entries, others, False)
+    out = []
+    for (n1, n2), (_, c1, c2, a, b) in sorted(worst.items()):
+        f1, f2 = flights[n1], flights[n2]
+        out.append(f"conflict: flights {f1['id']} ({f1['aircraft']}) in cell {c1} and {f2['id']} ({f2['aircraft']}) "
+                   f"in cell {c2} overlap from {a:.3f} s to {b:.3f} s")
+    return out
+
+
+def _close(a: float, b: float) -> bool:
+    return abs(a - b) <= TOL_S * max(1.0, abs(a), abs(b))
+
+
+def verify_files(flights_path: Path, schedule_path: Path, summary_path: Path | None = None) -> list[str]:
+    """Violations of the schedule in ``schedule_path`` for the flights of ``flights_path``."""
+    spec = _read_flights(flights_path)
+    rows = _read_schedule(schedule_path)
+    out: list[str] = []
+    ids = {f["id"] for f in spec["flights"]}
+    out += [f"flight {fid}: in schedule.csv but not in flights.json" for fid in rows if fid not in ids]
+    flown: list[dict] = []
+    by_aircraft: dict[str, list[dict]] = defaultdict(list)
+    for f in spec["flights"]:
+        by_aircraft[f["aircraft"]].append(f)
+        row = rows.get(f["id"])
+        if row is None:
+            out.append(f"flight {f['id']}: missing from schedule.csv")
+            f["operated"] = False
+            continue
+        if row["duplicate"]:
+            out.append(f"flight {f['id']}: listed more than once in schedule.csv")
+        if row["row"]["aircraft"] != f["aircraft"] or row["row"]["route"] != f["route"]:
+            out.append(f"flight {f['id']}: aircraft/route in schedule.csv differ from flights.json")
+        if not _close(row["planned"], f["planned"]):
+            out.append(f"flight {f['id']}: planned departure {row['planned']} differs from flights.json's {f['planned']}")
+        f["operated"] = row["operated"]
+        if not row["operated"]:
+            continue
+        d = f["delay"] = row["delay"]
+        f["departure"], f["arrival"] = row["departure"], row["arrival"]
+        if d < -TOL_S or d > f["max_delay"] + TOL_S:
+            out.append(f"flight {f['id']}: delay {d:g} s outside [0, {f['max_delay']:g}] s (Eq. 29)")
+        if not _close(f["departure"], f["planned"] + d):
+            out.append(f"flight {f['id']}: departure {f['departure']} s ≠ planned {f['planned']} + delay {d} s")
+        if not _close(f["arrival"], f["departure"] + f["length"] / f["speed"]):
+            out.append(f"flight {f['id']}: arrival {f['arrival']} s ≠ departure + track length / speed "
+                       f"= {f['departure'] + f['length'] / f['speed']:.6f} s")
+        if f["arrival"] > spec["service_end_s"] + TOL_S:
+            out.append(f"flight {f['id']}: arrives at {f['arrival']:.3f} s, after the service end {spec['service_end_s']:g} s (Eq. 26)")
+        flown.append(f)
+    t_out, t_back = spec["gaps"]
+    for chain in by_aircraft.values():
+        chain = sorted(chain, key=lambda f: f["planned"])  # stable: file order on ties
+        last = None
+        for leg, f in enumerate(chain, start=1):
+            if leg % 2 == 0 and f["operated"] and not chain[leg - 2]["operated"]:
+                out.append(f"flight {f['id']}: return operated without its outbound {chain[leg - 2]['id']}")
+            if not f["operated"]:
+                continue
+            if last is not None:
+                prev, prev_leg = last
+                gap = t_out if prev_leg % 2 == 1 else t_back
+                if f["departure"] < prev["arrival"] + gap - TOL_S:
+                    out.append(f"flight {f['id']}: departs at {f['departure']:.3f} s, less than {gap:g} s after "
+                               f"{prev['id']} arrives at {prev['arrival']:.3f} s (Eqs. 27-28)")
+            last = (f, leg)
+    out += _conflicts(flown, spec["cell"], spec["radius"])
+    if summary_path is not None and summary_path.is_file():
+        out += _check_summary(summary_path, spec, flown, len(by_aircraft))
+    return out
+
+
+def _check_summary(path: Path, spec: dict, flown: list[dict], n_aircraft: int) -> list[str]:
+    try:
+        summary = json.loads(path.read_text(encoding="utf-8"))
+    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        raise InputFileError(f"malformed JSON: {exc}", str(path), "rewrite it with uamopt schedule") from None
+    out: list[str] = []
+    total = sum(f["delay"] for f in flown)
+    expect = {"operated": len(flown), "cancelled": len(spec["flights"]) - len(flown),
+              "total_delay_s": total, "avg_delay_s": total / n_aircraft}
+    if summary.get("status") != "infeasible" and summary.get("objective") is not None and "weights" in summary:
+        w6, w7 = summary["weights"]
+        if summary.get("objective_kind", "weighted") == "weighted":
+            expect["objective"] = w6 * total / n_aircraft - w7 * len(flown)
+        else:
+            upper = sum(max(0.0, min(f["max_delay"], spec["service_end_s"] - f["planned"] - f["length"] / f["speed"]))
+                        for f in spec["flights"])
+            expect["objective"] = -len(flown) + total / (upper + 1.0)
+    for key, value in expect.items():
+        got = summary.get(key)
+        if not isinstance(got, (int, float)) or not _close(float(got), float(value)):
+            out.append(f"summary.json: {key} = {got!r}, the schedule gives {value:.6g}")
+    if summary.get("status") not in ("optimal", "feasible", "time_limit", "infeasible"):
+        out.append(f"summary.json: unknown status {summary.get('status')!r}")
+    return out
+
+
+def verify_dir(path: str | Path) -> list[str]:
+    """Check ``path``/schedule.csv against ``path``/flights.json (and summary.json if present).
+
+    Returns the violations, one line each; empty means feasible and conflict-free.
+
+    Raises
+    ------
+    InputFileError
+        The folder or a file is missing or malformed.
+    """
+    folder = Path(path)
+    if not folder.is_dir():
+        raise InputFileError(f"not a folder: {folder}", "uamopt verify", "give the --out folder of uamopt schedule")
+    return verify_files(folder / "flights.json", folder / "schedule.csv", folder / "summary.json")
