@@ -15,7 +15,12 @@ import pytest
 
 from uamopt.errors import InputFileError
 from uamopt.planning import grid_search
-from uamopt.planning.movingai import movingai_problem, read_map, read_map_text, read_scenarios
+from uamopt.planning.movingai import (
+    movingai_problem,
+    read_map,
+    read_map_text,
+    read_scenarios,
+)
 
 # /work/shared sits beside the repository root (CI clones the repo with shared/ next to it).
 BENCHMARKS = Path(__file__).resolve().parents[2] / "shared" / "benchmarks" / "movingai"
@@ -70,7 +75,7 @@ def test_scenarios_fit_their_map(benchmark):
 
 
 def test_fast_backend_matches_optimal_lengths(benchmark):
-    octile, problem, rows = benchmark
+    _, problem, rows = benchmark
     chosen = sample(rows)
     buckets = {r.bucket for r in chosen}
     assert min(buckets) == min(r.bucket for r in rows) and max(buckets) == max(r.bucket for r in rows)

@@ -11,6 +11,7 @@ from hypothesis import strategies as st
 
 from uamopt.schedule.flights import Flight, FlightSet
 from uamopt.schedule.occupancy import (
+    conflict_table,
     flight_occupancies,
     forbidden_gaps,
     track_occupancy,
@@ -126,6 +127,37 @@ def test_forbidden_intervals_match_brute_force(radius):
             assert inside == _overlap_brute(occs[key[p]], occs[key[q]], delta, radius), (p, q, delta)
             checked += 1
     assert checked > 20000 and len(conflicts) > 5
+
+
+def _clipped(fs, table):
+    """{(p, q): intervals clipped to the pair's feasible range of δ}."""
+    dep, upper = fs.planned_departure_s, fs.delay_upper_s
+    out = {}
+    for c in table:
+        lo, hi = dep[c.q] - dep[c.p] - upper[c.p], dep[c.q] - dep[c.p] + upper[c.q]
+        out[(c.p, c.q)] = np.clip(c.intervals, lo, hi)
+    return out
+
+
+@pytest.mark.parametrize("radius", [0, 1])
+def test_flight_level_join_equals_track_level(radius):
+    """Forcing the per-flight join (as for many distinct tracks) gives the same constraints."""
+    rng = np.random.default_rng(5)
+    base = [[[5, 5, 15], [95, 5, 15]], [[95, 5, 25], [5, 5, 25]], [[50, 0, 15], [50, 90, 15]],
+            [[10, 80, 5], [60, 20, 35], [90, 90, 15]]]
+    flights = []
+    for i in range(60):
+        track = np.array(base[i % 4], dtype=float)
+        if i % 3 == 0:  # a third of the flights get a track of their own
+            track[1:-1 if len(track) > 2 else None, :2] += rng.uniform(-4, 4, 2)
+        flights.append(_flight(f"F{i}", f"A{i % 17}", np.clip(track, 0, 100), 100.0 * (i // 17) + float(rng.integers(0, 60)), 25.0))
+    fs = FlightSet(cell=CUBE, conflict_radius=radius, flights=tuple(flights), service_end_s=10_000.0,
+                   outbound_gap_s=0.0, return_gap_s=0.0)
+    track_level, flight_level = conflict_table(fs), conflict_table(fs, max_track_pairs=0)
+    a, b = _clipped(fs, track_level), _clipped(fs, flight_level)
+    assert len(a) > 50 and a.keys() == b.keys()
+    for k in a:
+        np.testing.assert_allclose(a[k], b[k], atol=1e-9)
 
 
 def test_track_pair_gaps_same_track():

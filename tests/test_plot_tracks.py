@@ -107,7 +107,7 @@ def test_pareto_front_is_sorted_non_dominated_and_reaches_both_optima(coarse):
     # the cheapest point is the standard A* of the shortest stage (transport only)
     start, goal = endpoint_cell(model, ORIGIN, "origin"), endpoint_cell(model, DESTINATION, "destination")
     shortest = grid_search(model.search_problem("shortest"), start, goal)
-    assert t[0] == pytest.approx(shortest.cost, rel=1e-9)
+    assert t[0] == pytest.approx(shortest.cost, rel=1e-6)  # the shortest search adds a 1e-9 risk tie-break
     assert t[0] == pytest.approx(plan.stages["shortest"].transport_cost, rel=1e-9)
     # the safest point is the least-risk search (transport only breaking ties)
     zero = np.zeros(model.admissible.shape)

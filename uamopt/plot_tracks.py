@@ -129,15 +129,8 @@ def detour_window(plan: TrackPlan, field: RiskField, aspect: float = 1.0) -> tup
     reach = float(np.hypot(*toward))
     cx, cy = pts[fork] + (toward * min(1.0, 0.35 * min(w, h) / reach) if reach > 0 else 0.0)
     x0, y0 = np.clip(cx - w / 2, 0.0, ex - w), np.clip(cy - h / 2, 0.0, ey - h)
-    return float(x0), float(x0 + w), float(y0), float(y0 + h), layer_of(field, np.interp(s[fork], d, initial[:, 2]))
-
-
-def _nearest_on_polyline(point: np.ndarray, line: np.ndarray) -> np.ndarray:
-    a, b = line[:-1, :2], line[1:, :2]
-    ab = b - a
-    t = np.clip(np.einsum("ij,ij->i", point[:2] - a, ab) / np.maximum(np.einsum("ij,ij->i", ab, ab), 1e-12), 0, 1)
-    foot = a + t[:, None] * ab
-    return foot[np.argmin(np.linalg.norm(foot - point[:2], axis=1))]
+    k = layer_of(field, float(np.interp(s[fork], d, initial[:, 2])))
+    return float(x0), float(x0 + w), float(y0), float(y0 + h), k
 
 
 # --- drawing helpers ------------------------------------------------------------------------
@@ -267,8 +260,8 @@ def _panel_zoom(ax, model, plan, norm, cmap, window):
     ax.set_aspect("equal")
     ax.tick_params(labelsize=7)
     z0, z1 = k * g.cell[2], (k + 1) * g.cell[2]
-    ax.set_title(f"(b) where the largest detour starts, layer k={k}: z = {z0:g}–{z1:g} m\norange: the initial track's columns; gold dots: "
-                 "equivalent waypoints; dotted: clearance margin (Eq. 15)",
+    ax.set_title(f"(b) where the largest detour starts, layer k={k}: z = {z0:g}–{z1:g} m\n"
+                 "orange: the initial track's columns; gold dots: equivalent waypoints",
                  fontsize=8.5, loc="left")
 
 
@@ -371,8 +364,10 @@ def plot_tracks(model: PlanningModel, plan: TrackPlan, path: str | Path, *, titl
     handles += [Line2D([], [], ls="", marker="o", mfc="white", mec="black", label="origin"),
                 Line2D([], [], ls="", marker="*", ms=10, mfc="white", mec="black", label="destination"),
                 Patch(facecolor=OBSTACLE_GREY, label="building (obstacle)"),
-                Patch(facecolor="none", edgecolor=NO_FLY, hatch="////", label="no-fly")]
-    ax_a.legend(handles=handles, **{**LEGEND_BELOW, "ncol": 1, "fontsize": 7.5})
+                Patch(facecolor="none", edgecolor=NO_FLY, hatch="////", label="no-fly"),
+                Patch(facecolor="none", edgecolor="0.15", hatch="....", lw=0,
+                      label="clearance margin (Eq. 15), in (b)")]
+    ax_a.legend(handles=handles, **{**LEGEND_BELOW, "ncol": 1 if tall else 2, "fontsize": 7.5})
     head = f"{title} — " if title else ""
     o, dst = plan.origin, plan.destination
     w4, w5 = model.scenario.tracks.weights
@@ -390,7 +385,9 @@ def pair_directions(tracks: Mapping[str, np.ndarray], tolerance_m: float) -> lis
     """Group tracks into routes: (forward, reverse) where one track's origin is the other's
     destination (within ``tolerance_m`` horizontally), else (track, None); in the given order."""
     ends = {n: (np.asarray(w, dtype=float)[0, :2], np.asarray(w, dtype=float)[-1, :2]) for n, w in tracks.items()}
-    close = lambda a, b: float(np.hypot(*(a - b))) <= tolerance_m  # noqa: E731
+
+    def close(p: np.ndarray, q: np.ndarray) -> bool:
+        return float(np.hypot(*(p - q))) <= tolerance_m
     pairs, used = [], set()
     for a in tracks:
         if a in used:

@@ -193,7 +193,7 @@ def plot_pareto(points: Sequence[ParetoPoint], path: str | Path, *, plan: TrackP
     """Draw the trade-off of Fig. 21 and write an 8 × 5.5 in PNG at 130 dpi.
 
     ``points`` may hold a whole :func:`weight_sweep`: the non-dominated ones form the front
-    (line and markers, labelled with ω5/ω4), the others are greyed. With ``plan``, its four
+    (line and markers, each labelled with its (ω4, ω5)), the others are greyed. With ``plan``, its four
     stages (Table 2) are marked in the colours of Fig. 18 for comparison.
     """
     from uamopt.plot_tracks import STAGE_STYLE  # the stage colours; a plotting import, kept local
@@ -211,18 +211,21 @@ def plot_pareto(points: Sequence[ParetoPoint], path: str | Path, *, plan: TrackP
         ax.scatter([p.transport_cost for p in rest], [p.risk_cost for p in rest], s=28, c="0.7",
                    edgecolors="0.45", linewidths=0.6, zorder=3, label="dominated")
     ax.plot([p.transport_cost for p in front], [p.risk_cost for p in front], color="#1f4e9c", lw=1.4,
-            marker="o", ms=6, mfc="white", mew=1.4, zorder=4, label=f"Pareto front ({len(front)} track{'s' if len(front) > 1 else ''})")
-    for n, p in enumerate(front):  # labels alternate sides so neighbours do not collide
-        left = n % 2 == 1
-        ax.annotate(f"(ω4, ω5) = ({p.w4:.2g}, {p.w5:.2g})", (p.transport_cost, p.risk_cost),
-                    xytext=(-7 if left else 7, 0), textcoords="offset points", fontsize=6.5, color="#1f4e9c",
-                    va="center", ha="right" if left else "left", zorder=6)
+            marker="o", ms=6, mfc="white", mew=1.4, zorder=4,
+            label=f"Pareto front ({len(front)} track{'s' if len(front) > 1 else ''})")
     if plan is not None:
         for name, marker in zip(STAGES, "sDPo"):
             st = plan.stages[name]
             ax.scatter([st.transport_cost], [st.risk_cost], marker=marker, s=55, c=STAGE_STYLE[name][1],
                        edgecolors="black", linewidths=0.7, zorder=5, label=f"{name} track (Table 2)")
-    ax.margins(x=0.25, y=0.08)  # room for the weight labels
+    ax.margins(x=0.12, y=0.08)
+    ax.autoscale_view()
+    middle = 0.5 * sum(ax.get_xlim())
+    for p in front:  # labels point inwards, away from the axes' edges
+        left = p.transport_cost > middle
+        ax.annotate(f"(ω4, ω5) = ({p.w4:.2g}, {p.w5:.2g})", (p.transport_cost, p.risk_cost),
+                    xytext=(-7 if left else 7, 0), textcoords="offset points", fontsize=6.5, color="#1f4e9c",
+                    va="center", ha="right" if left else "left", zorder=6)
     ax.set_xlabel("transport cost C_T (¥, Eq. 12)", fontsize=9)
     ax.set_ylabel("operational risk cost C_R (Eq. 11)", fontsize=9)
     ax.tick_params(labelsize=8)

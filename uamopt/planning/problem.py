@@ -91,6 +91,12 @@ def clearance_ok(obstacle: np.ndarray, cell: tuple[float, float, float], clearan
     return distance >= clearance_m - 1e-9
 
 
+#: Risk weight of the shortest-track search, ¥ per metre of R = 1: a tie-break only. A whole
+#: track's risk (< 10⁵ R·m) then weighs < 10⁻⁴ ¥, while two grid paths differing in their moves
+#: differ in transport cost by at least ~(√2 − 1)·Δ·c_h ≈ 10⁻² ¥.
+SHORTEST_TIE_BREAK = 1e-9
+
+
 @dataclass(frozen=True)
 class PlanningModel:
     """Everything the planner's stages need, derived once from the scenario and the risk field."""
@@ -105,11 +111,14 @@ class PlanningModel:
     c_v: float  # c_v c_e τ, ¥/m
 
     def search_problem(self, stage: str) -> SearchProblem:
-        """``shortest``: transport cost only (standard A*); ``initial``: Eqs. 10–13 plus μ·R(t)."""
+        """``shortest``: transport cost (standard A*), risk only breaking ties between equally cheap
+        tracks (weight ``SHORTEST_TIE_BREAK`` ¥ per risky metre, far below any difference in
+        transport cost between two grid paths); ``initial``: Eqs. 10–13 plus μ·R(t)."""
         w_risk, w_transport = self.scenario.tracks.weights
         if stage == "shortest":
             zero = np.zeros(self.admissible.shape)
-            return SearchProblem(self.admissible, zero, zero, self.field.grid.cell, 0.0, self.c_h, self.c_v)
+            return SearchProblem(self.admissible, self.risk, zero, self.field.grid.cell, SHORTEST_TIE_BREAK,
+                                 self.c_h, self.c_v)
         if stage != "initial":
             raise ValueError(f"stage must be 'shortest' or 'initial', got {stage!r}")
         penalty = self.scenario.tracks.buffer_penalty * self.shell_count

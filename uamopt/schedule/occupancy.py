@@ -164,56 +164,115 @@ def _group_merge(group: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> tuple[np.
     return group[idx], lo[idx], np.maximum.reduceat(hi, idx)
 
 
-def track_pair_gaps(occupancies: list[Occupancy], radius: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+def _cell_codes(cells: np.ndarray, radius: int) -> tuple[np.ndarray, np.ndarray]:
+    """Integer codes of cells with room for ±r offsets, and the (2r+1)³ neighbour offsets."""
+    shift = cells.min(axis=0) - radius
+    dims = cells.max(axis=0) - shift + radius + 1
+    c = cells - shift
+    r = np.arange(-radius, radius + 1)
+    offsets = ((r[:, None, None] * dims[1] + r[None, :, None]) * dims[2] + r[None, None, :]).ravel()
+    return (c[:, 0] * dims[1] + c[:, 1]) * dims[2] + c[:, 2], offsets
+
+
+def _near_pairs(code: np.ndarray, offsets: np.ndarray, max_pairs: int | None = None) -> tuple[np.ndarray, np.ndarray] | None:
+    """All (i, j) with code[j] + o == code[i] for an offset o: a sort-merge join of the rows with
+    their dilated copies, one vectorised pass per offset. ``None`` if there would be more than
+    ``max_pairs`` (counted before anything is built)."""
+    order = np.argsort(code, kind="stable")
+    sorted_code = code[order]
+
+    def matches(off):  # the needles sorted_code + off are sorted: a fast, cache-friendly search
+        first = np.searchsorted(sorted_code, sorted_code + off, side="left")
+        return first, np.searchsorted(sorted_code, sorted_code + off, side="right") - first
+
+    if max_pairs is not None and sum(int(matches(off)[1].sum()) for off in offsets) > max_pairs:
+        return None  # counted without building anything
+    base, probe = [], []
+    for off in offsets:
+        first, count = matches(off)
+        hit = np.flatnonzero(count)
+        reps = count[hit]
+        probe.append(np.repeat(order[hit], reps))
+        base.append(order[np.repeat(first[hit] - (np.cumsum(reps) - reps), reps) + np.arange(reps.sum())])
+    return np.concatenate(base), np.concatenate(probe)
+
+
+def track_pair_gaps(
+    occupancies: list[Occupancy], radius: int, max_pairs: int | None = None
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None:
     """Forbidden δ = dep_q − dep_p for every ordered pair of tracks (A for p, B for q).
 
     Returns ``(pair_code, ptr, lo, hi)``: ``pair_code`` = A·K + B (sorted, only pairs with a
     conflict), the intervals of pair ``pair_code[g]`` are ``lo[ptr[g]:ptr[g+1]]``, ``hi[...]``.
     Visits are joined on cell codes: each visit is dilated to its (2r+1)³ neighbours and matched
-    against all visits by binary search on the sorted codes.
+    against all visits by binary search on the sorted codes. ``None`` when the join would exceed
+    ``max_pairs`` pairs of visits (many distinct tracks through the same cells).
     """
     n_keys = len(occupancies)
-    cells = np.concatenate([o.cells for o in occupancies])
     t_in = np.concatenate([o.t_in for o in occupancies])
     t_out = np.concatenate([o.t_out for o in occupancies])
     owner = np.repeat(np.arange(n_keys), [len(o) for o in occupancies])
-    shift = cells.min(axis=0) - radius
-    dims = cells.max(axis=0) - shift + radius + 1
-    c = cells - shift
-    code = (c[:, 0] * dims[1] + c[:, 1]) * dims[2] + c[:, 2]
-    order = np.argsort(code, kind="stable")
-    sorted_code = code[order]
-    r = np.arange(-radius, radius + 1)
-    offsets = ((r[:, None, None] * dims[1] + r[None, :, None]) * dims[2] + r[None, None, :]).ravel()
-    pairs_base, pairs_dil = [], []
-    for off in offsets:  # (2r+1)³ passes, each vectorised over all visits
-        probe = code + off
-        first = np.searchsorted(sorted_code, probe, side="left")
-        count = np.searchsorted(sorted_code, probe, side="right") - first
-        hit = np.flatnonzero(count)
-        if len(hit) == 0:
-            continue
-        reps = count[hit]
-        dil = np.repeat(hit, reps)
-        pos = np.repeat(first[hit] - (np.cumsum(reps) - reps), reps) + np.arange(reps.sum())
-        pairs_base.append(order[pos])
-        pairs_dil.append(dil)
-    if not pairs_base:
-        empty = np.zeros(0)
-        return np.zeros(0, dtype=np.int64), np.zeros(1, dtype=np.int64), empty, empty
-    base = np.concatenate(pairs_base)  # visit of p (track A)
-    dil = np.concatenate(pairs_dil)  # visit of q (track B), within r of p's cell
-    group = owner[base] * n_keys + owner[dil]
-    g, lo, hi = _group_merge(group, t_in[base] - t_out[dil], t_out[base] - t_in[dil])
+    code, offsets = _cell_codes(np.concatenate([o.cells for o in occupancies]), radius)
+    joined = _near_pairs(code, offsets, max_pairs)
+    if joined is None:
+        return None
+    base, dil = joined  # visit of p (track A); visit of q (track B) within r of p's cell
+    if len(base) == 0:
+        return np.zeros(0, dtype=np.int64), np.zeros(1, dtype=np.int64), np.zeros(0), np.zeros(0)
+    g, lo, hi = _group_merge(owner[base] * n_keys + owner[dil], t_in[base] - t_out[dil], t_out[base] - t_in[dil])
+    pair_code, starts = np.unique(g, return_index=True)
+    return pair_code, np.append(starts, len(g)).astype(np.int64), lo, hi
+
+
+def flight_pair_gaps(
+    flightset: FlightSet, occupancies: list[Occupancy], key: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Forbidden δ per flight pair p < q directly, for flight sets with many distinct tracks.
+
+    Each visit of flight f can happen during [D_f + t_in, D_f + Δd_f + t_out]; visits are hashed
+    by (cell, time bucket) and only visits in neighbouring cells whose windows overlap are joined
+    (a pair sharing several buckets is kept in its first common bucket only).
+    Returns ``(pair_code = p·n + q, ptr, lo, hi)`` like :func:`track_pair_gaps`.
+    """
+    n = len(flightset)
+    size = np.array([len(o) for o in occupancies])
+    vstart = np.concatenate([[0], np.cumsum(size)])
+    t_in = np.concatenate([o.t_in for o in occupancies])
+    t_out = np.concatenate([o.t_out for o in occupancies])
+    code, offsets = _cell_codes(np.concatenate([o.cells for o in occupancies]), flightset.conflict_radius)
+    count = size[key]  # visits per flight
+    flight = np.repeat(np.arange(n), count)
+    visit = np.repeat(vstart[key] - np.cumsum(count) + count, count) + np.arange(count.sum())
+    dep, upper = flightset.planned_departure_s, flightset.delay_upper_s
+    w_lo = dep[flight] + t_in[visit] - TIME_TOL_S
+    w_hi = dep[flight] + upper[flight] + t_out[visit] + TIME_TOL_S
+    width = max(float(np.median(w_hi - w_lo)), 1.0)
+    b0 = np.floor((w_lo - w_lo.min()) / width).astype(np.int64)
+    b1 = np.floor((w_hi - w_lo.min()) / width).astype(np.int64)
+    reps = b1 - b0 + 1
+    row = np.repeat(np.arange(len(flight)), reps)
+    bucket = np.repeat(b0 - np.cumsum(reps) + reps, reps) + np.arange(reps.sum())
+    n_buckets = int(b1.max()) + 1
+    base, probe = _near_pairs(code[visit[row]] * n_buckets + bucket, offsets * n_buckets)  # type: ignore[misc]
+    rb, rp = row[base], row[probe]
+    fp, fq = flight[rb], flight[rp]
+    keep = ((fp < fq) & (flightset.aircraft_index[fp] != flightset.aircraft_index[fq])
+            & (bucket[base] == np.maximum(b0[rb], b0[rp])) & (w_lo[rb] < w_hi[rp]) & (w_lo[rp] < w_hi[rb]))
+    rb, rp, fp, fq = rb[keep], rp[keep], fp[keep], fq[keep]
+    if len(rb) == 0:
+        return np.zeros(0, dtype=np.int64), np.zeros(1, dtype=np.int64), np.zeros(0), np.zeros(0)
+    vb, vp = visit[rb], visit[rp]
+    g, lo, hi = _group_merge(fp * n + fq, t_in[vb] - t_out[vp], t_out[vb] - t_in[vp])
     pair_code, starts = np.unique(g, return_index=True)
     return pair_code, np.append(starts, len(g)).astype(np.int64), lo, hi
 
 
 def candidate_pairs(flightset: FlightSet) -> tuple[np.ndarray, np.ndarray]:
     """Flight pairs (p < q, different aircraft) whose possible flying windows
-    [D, D + Δd_upper + flight time] overlap; only those can ever conflict."""
+    [D, D + Δd_upper + flight time] overlap (widened by ``TIME_TOL_S``, as in :func:`conflict_table`);
+    only those can ever conflict."""
     start = flightset.planned_departure_s
-    end = start + flightset.delay_upper_s + flightset.flight_time_s
+    end = start + flightset.delay_upper_s + flightset.flight_time_s + 2 * TIME_TOL_S
     order = np.argsort(start, kind="stable")
     s_sorted = start[order]
     stop = np.searchsorted(s_sorted, end[order], side="left")
@@ -228,7 +287,10 @@ def candidate_pairs(flightset: FlightSet) -> tuple[np.ndarray, np.ndarray]:
     return p[keep], q[keep]
 
 
-def conflict_table(flightset: FlightSet) -> ConflictTable:
+MAX_TRACK_PAIRS = 30_000_000  # visit pairs of the track-level join before switching to flight level
+
+
+def conflict_table(flightset: FlightSet, *, max_track_pairs: int = MAX_TRACK_PAIRS) -> ConflictTable:
     """Every flight pair that can conflict, with its forbidden open intervals of δ = dep_q − dep_p,
     as arrays (the vectorised core of :func:`forbidden_gaps`).
 
@@ -237,16 +299,33 @@ def conflict_table(flightset: FlightSet) -> ConflictTable:
     (``FlightSet.delay_upper_s``); only those intervals are stored, widened to any interval within
     ``TIME_TOL_S`` of the range (conservative). Pairs of flights of the same aircraft are left out:
     the turnaround rule already keeps them apart in time.
+
+    Flights sharing a track share its intervals (:func:`track_pair_gaps`); when the tracks are so
+    many and so intertwined that this join would exceed ``max_track_pairs`` visit pairs, the
+    intervals are computed per flight pair instead (:func:`flight_pair_gaps`). Both give the same.
     """
     occupancies, key = flight_occupancies(flightset)
-    pair_code, ptr, lo, hi = track_pair_gaps(occupancies, flightset.conflict_radius)
-    p, q = candidate_pairs(flightset)
-    if len(p) == 0 or len(pair_code) == 0:
-        return ConflictTable.empty()
-    code = key[p] * len(occupancies) + key[q]
-    pos = np.minimum(np.searchsorted(pair_code, code), len(pair_code) - 1)
-    found = pair_code[pos] == code
-    p, q, grp = p[found], q[found], pos[found]
+    gaps = track_pair_gaps(occupancies, flightset.conflict_radius, max_track_pairs)
+    if gaps is not None:
+        pair_code, ptr, lo, hi = gaps
+        p, q = candidate_pairs(flightset)
+        if len(p) == 0 or len(pair_code) == 0:
+            return ConflictTable.empty()
+        code = key[p] * len(occupancies) + key[q]
+        pos = np.minimum(np.searchsorted(pair_code, code), len(pair_code) - 1)
+        found = pair_code[pos] == code
+        p, q, grp = p[found], q[found], pos[found]
+    else:
+        pair_code, ptr, lo, hi = flight_pair_gaps(flightset, occupancies, key)
+        if len(pair_code) == 0:
+            return ConflictTable.empty()
+        p, q = np.divmod(pair_code, len(flightset))
+        grp = np.arange(len(pair_code))
+    return _prune_to_ranges(flightset, p, q, grp, pair_code, ptr, lo, hi)
+
+
+def _prune_to_ranges(flightset, p, q, grp, pair_code, ptr, lo, hi) -> ConflictTable:
+    """Keep, for each flight pair (p, q) with interval group ``grp``, the intervals meeting its range of δ."""
     dep, upper = flightset.planned_departure_s, flightset.delay_upper_s
     range_lo = dep[q] - dep[p] - upper[p] - TIME_TOL_S
     range_hi = dep[q] - dep[p] + upper[q] + TIME_TOL_S

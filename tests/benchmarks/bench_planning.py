@@ -1,0 +1,181 @@
+"""Benchmark: the track planner's optimal search and the whole four-stage plan.
+
+Run on demand (not collected by pytest; several minutes, most of it the 8010 maze rows):
+
+    .venv/bin/python tests/benchmarks/bench_planning.py [--movingai-rows N] [--nx-cell 20] [--cells 10 5]
+
+(i)   Moving AI: every scenario row of both maps in shared/benchmarks/movingai (beside the repo
+      root), fast backend with the transport heuristic: rows matching the optimal length to 1e-3,
+      and the total time.
+(ii)  The paper case at 10 m cells, P_O → P_D: time of ``planning_model`` and of ``plan_track``
+      (all four stages), numba warmed up first on a tiny problem. Target: plan < 5 s.
+(iii) The peer in the same run: the initial-stage search with networkx's A* vs the fast backend
+      on the same graph and heuristic. networkx needs minutes at 10 m cells, so this is the paper
+      case at ``--nx-cell`` (20 m: 0.5 million cells, networkx ≈ 40 s). Target: ≥ 30×.
+(iv)  The paper case at 5 m cells (32 million cells): plan time and peak resident memory.
+      Targets: < 60 s, < 6 GB.
+
+(ii) and (iv) each run in a fresh subprocess, so each peak memory (``ru_maxrss``, which includes
+the city and the risk field the planner needs) is that cell size's alone.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import resource
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT))
+
+from uamopt import build_grid, load_city, load_scenario, risk_field  # noqa: E402
+from uamopt.graph import grid_graph  # noqa: E402
+from uamopt.planning import SearchProblem, grid_search, plan_track, planning_model  # noqa: E402
+from uamopt.planning.movingai import movingai_problem, read_map, read_scenarios  # noqa: E402
+from uamopt.planning.tracks import endpoint_cell  # noqa: E402
+
+MOVINGAI = ROOT.parent / "shared" / "benchmarks" / "movingai"
+MAPS = ("arena.map", "maze512-32-9.map")
+SCENARIO = ROOT / "models" / "paper_case.toml"
+P_O, P_D = (300.0, 300.0, 120.0), (2220.0, 4220.0, 120.0)  # Table B.3
+TARGET_PLAN_S = {10.0: 5.0, 5.0: 60.0}
+TARGET_RSS_GB = {5.0: 6.0}
+TARGET_RATIO = 30.0
+
+
+def warm_up() -> None:
+    """Load (or compile) the numba search once, so timings measure the search alone."""
+    free = np.ones((3, 3, 2), dtype=bool)
+    zero = np.zeros(free.shape)
+    problem = SearchProblem(free, zero, zero, (1.0, 1.0, 1.0), 1.0, 1.0, 1.0)
+    for heuristic in ("transport", "zero"):
+        grid_search(problem, (0, 0, 0), (2, 2, 1), heuristic=heuristic)
+
+
+def paper_model(cell_m: float):
+    """(model, start cell, goal cell, seconds for city + risk field, seconds for planning_model)."""
+    scenario = load_scenario(SCENARIO, [f"grid.cell=[{cell_m},{cell_m},{cell_m}]"])
+    t0 = time.perf_counter()
+    grid = build_grid(scenario)
+    field = risk_field(scenario, grid, load_city(scenario, grid))
+    t_field = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    model = planning_model(scenario, field)
+    t_model = time.perf_counter() - t0
+    return model, endpoint_cell(model, P_O, "origin"), endpoint_cell(model, P_D, "destination"), t_field, t_model
+
+
+def movingai(rows_per_map: int) -> list[dict]:
+    out = []
+    for name in MAPS:
+        problem = movingai_problem(read_map(MOVINGAI / name))
+        rows = read_scenarios(MOVINGAI / f"{name}.scen")
+        if rows_per_map:
+            rows = rows[len(rows) - 1::-max(1, len(rows) // rows_per_map)][::-1]
+        matched, worst, expansions = 0, 0.0, 0
+        t0 = time.perf_counter()
+        for row in rows:
+            result = grid_search(problem, *row.cells(), backend="fast", heuristic="transport")
+            error = abs(result.cost - row.optimal_length)
+            matched += error <= 1e-3
+            worst = max(worst, error)
+            expansions += result.expansions
+        out.append({"map": name, "rows": len(rows), "matched": matched, "worst_error": worst,
+                    "seconds": time.perf_counter() - t0, "mean_expansions": expansions / len(rows)})
+    return out
+
+
+def networkx_peer(cell_m: float) -> dict:
+    """Initial-stage search, transport heuristic, fast vs networkx on the same problem."""
+    model, start, goal, _, _ = paper_model(cell_m)
+    problem = model.search_problem("initial")
+    fast = min((grid_search(problem, start, goal, backend="fast") for _ in range(3)), key=lambda r: r.seconds)
+    t0 = time.perf_counter()
+    graph = grid_graph(problem.passable, problem.cell)
+    t_graph = time.perf_counter() - t0
+    edges = graph.number_of_edges()
+    del graph
+    reference = grid_search(problem, start, goal, backend="networkx")
+    return {"cell_m": cell_m, "shape": list(problem.shape), "edges": edges, "fast_s": fast.seconds,
+            "networkx_s": reference.seconds, "graph_build_s": t_graph, "fast_cost": fast.cost,
+            "networkx_cost": reference.cost, "expansions": fast.expansions}
+
+
+def plan_child(cell_m: float) -> dict:
+    """Body of the subprocess for (ii)/(iv): warm up, build the model, plan, report."""
+    warm_up()
+    model, _, _, t_field, t_model = paper_model(cell_m)
+    t0 = time.perf_counter()
+    plan = plan_track(model, P_O, P_D)
+    t_plan = time.perf_counter() - t0
+    return {"cell_m": cell_m, "shape": list(model.admissible.shape), "field_s": t_field, "model_s": t_model,
+            "plan_s": t_plan, "stages_s": {k: v.seconds for k, v in plan.stages.items()},
+            "expansions": {k: plan.stages[k].extra["expansions"] for k in ("shortest", "initial")},
+            "maxrss_gb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2**20}
+
+
+def run_child(cell_m: float) -> dict:
+    out = subprocess.run([sys.executable, __file__, "--child", str(cell_m)], check=True, capture_output=True,
+                         text=True, cwd=ROOT)
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def verdict(ok: bool) -> str:
+    return "ok" if ok else "MISSED"
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--movingai-rows", type=int, default=0, help="rows per map, evenly spread; 0 = all")
+    parser.add_argument("--nx-cell", type=float, default=20.0, help="cell side (m) of the networkx comparison")
+    parser.add_argument("--cells", type=float, nargs="*", default=[10.0, 5.0], help="cell sides (m) to plan at")
+    parser.add_argument("--child", type=float, help=argparse.SUPPRESS)
+    args = parser.parse_args()
+    if args.child is not None:
+        print(json.dumps(plan_child(args.child)))
+        return
+
+    warm_up()
+    table: list[tuple[str, str, str, str]] = []
+    if not MOVINGAI.is_dir():
+        sys.exit(f"Moving AI benchmarks not found at {MOVINGAI}")
+    for m in movingai(args.movingai_rows):
+        result = (f"{m['matched']}/{m['rows']} rows match, worst |err| {m['worst_error']:.1e}; {m['seconds']:.1f} s "
+                  f"({1e3 * m['seconds'] / m['rows']:.1f} ms/row, {m['mean_expansions']:.0f} expansions/row)")
+        table.append((f"(i) Moving AI {m['map']}", result, "all", verdict(m["matched"] == m["rows"])))
+    for cell_m in args.cells:
+        c = run_child(cell_m)
+        target = TARGET_PLAN_S.get(cell_m)
+        stages = ", ".join(f"{k} {v:.2f}" for k, v in c["stages_s"].items())
+        label = "(ii)" if cell_m == 10 else "(iv)" if cell_m == 5 else "    "
+        result = (f"city+risk {c['field_s']:.2f} s, planning_model {c['model_s']:.2f} s, plan_track {c['plan_s']:.2f} s "
+                  f"[{stages}; initial expansions {c['expansions']['initial']}]")
+        table.append((f"{label} paper case {cell_m:g} m {tuple(c['shape'])}", result,
+                      f"< {target:g} s" if target else "", verdict(c["plan_s"] < target) if target else ""))
+        rss_target = TARGET_RSS_GB.get(cell_m)
+        table.append((f"     peak memory {cell_m:g} m", f"{c['maxrss_gb']:.2f} GB (whole process: city, risk, model, plan)",
+                      f"< {rss_target:g} GB" if rss_target else "",
+                      verdict(c["maxrss_gb"] < rss_target) if rss_target else ""))
+    if args.nx_cell:
+        p = networkx_peer(args.nx_cell)
+        ratio = p["networkx_s"] / p["fast_s"]
+        agree = abs(p["networkx_cost"] - p["fast_cost"]) <= 1e-9 * abs(p["fast_cost"])
+        result = (f"fast {p['fast_s']:.3f} s, networkx {p['networkx_s']:.1f} s (graph build {p['graph_build_s']:.1f} s, "
+                  f"{p['edges']} edges): {ratio:.0f}x, {(p['networkx_s'] - p['graph_build_s']) / p['fast_s']:.0f}x "
+                  f"search only; costs {'agree' if agree else 'DIFFER'} ({p['fast_cost']:.6f})")
+        table.append((f"(iii) initial search {p['cell_m']:g} m {tuple(p['shape'])}", result,
+                      f">= {TARGET_RATIO:g}x", verdict(ratio >= TARGET_RATIO and agree)))
+    width = max(len(row[0]) for row in table)
+    print(f"{'benchmark':<{width}}  result  [target, verdict]")
+    for name, result, target, ok in table:
+        print(f"{name:<{width}}  {result}" + (f"  [{target}, {ok}]" if target else ""))
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,173 @@
+"""The four searches of the track planner return the same optimal cost.
+
+(a) the paper's A*, heuristic 0 (Dijkstra), pure Python; (b) A* with the admissible transport
+heuristic, pure Python; (c) networkx's ``astar_path`` on the explicit graph, the reference;
+(d) the numba backend with both heuristics. They must agree to a relative 1e-9 on the paper case
+(P_O → P_D, shortest and initial stage) and on random small cities, and every returned path must
+be a valid track: 26-neighbour moves through passable cells, no cut corner, and a cost that,
+recomputed from the path alone, equals the reported one. Whether a path exists at all is
+checked against an oracle outside the planner: with no corner cutting, a diagonal move needs its
+whole bounding box passable, so two cells are joined exactly when they lie in one face-connected
+(6-connected) component.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import event, given, settings
+from hypothesis import strategies as st
+from scipy import ndimage
+
+from uamopt.errors import NoTrackError
+from uamopt.planning import SearchProblem, grid_search, planning_model
+from uamopt.planning.tracks import endpoint_cell
+
+#: (backend, heuristic): (a), (b), (c), (d) of the module docstring
+SEARCHES = (("python", "zero"), ("python", "transport"), ("networkx", "zero"), ("fast", "zero"),
+            ("fast", "transport"))
+REL = 1e-9
+P_O, P_D = (300.0, 300.0, 120.0), (2220.0, 4220.0, 120.0)  # Table B.3
+
+
+def path_cost(problem: SearchProblem, path: np.ndarray) -> float:
+    """Σ ω4 ½(R_n + R_m) d + c_h' horizontal + c_v' |vertical| + penalty_m over the moves, from
+    the problem's arrays alone (search.py's module docstring)."""
+    cell = np.asarray(problem.cell, dtype=float)
+    total = 0.0
+    for u, v in zip(map(tuple, path[:-1]), map(tuple, path[1:])):
+        step = (np.asarray(v) - np.asarray(u)) * cell
+        total += (problem.w_risk * 0.5 * (problem.risk[u] + problem.risk[v]) * math.sqrt(float(step @ step))
+                  + problem.c_h * math.hypot(step[0], step[1]) + problem.c_v * abs(step[2]) + problem.penalty[v])
+    return total
+
+
+def assert_valid_track(problem: SearchProblem, result, start, goal) -> None:
+    path = np.asarray(result.path)
+    assert path.ndim == 2 and path.shape[1] == 3
+    assert tuple(path[0]) == tuple(start) and tuple(path[-1]) == tuple(goal)
+    assert (path >= 0).all() and (path < np.asarray(problem.shape)).all()
+    step = np.diff(path, axis=0)
+    assert (np.abs(step) <= 1).all() and np.any(step != 0, axis=1).all(), "moves are between 26-neighbours"
+    assert problem.passable[tuple(path.T)].all(), "every cell is passable"
+    for u, d in zip(path[:-1], step):
+        lo, hi = np.minimum(u, u + d), np.maximum(u, u + d) + 1
+        box = problem.passable[lo[0]:hi[0], lo[1]:hi[1], lo[2]:hi[2]]
+        assert box.all(), f"move {tuple(u)} → {tuple(u + d)} cuts the corner of an impassable cell"
+    assert path_cost(problem, path) == pytest.approx(result.cost, rel=REL, abs=1e-12)
+
+
+def solve_all(problem: SearchProblem, start, goal, searches=SEARCHES) -> dict:
+    return {key: grid_search(problem, start, goal, backend=key[0], heuristic=key[1]) for key in searches}
+
+
+def assert_agree(problem: SearchProblem, results: dict, start, goal) -> None:
+    reference = results[("networkx", "zero")].cost if ("networkx", "zero") in results else None
+    for key, result in results.items():
+        assert_valid_track(problem, result, start, goal)
+        if reference is not None:
+            assert result.cost == pytest.approx(reference, rel=REL, abs=1e-12), key
+    fast_h, fast_0 = results[("fast", "transport")], results[("fast", "zero")]
+    assert fast_h.expansions <= fast_0.expansions
+
+
+# --- paper case ---------------------------------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def paper_model(root):
+    """The paper case at its 50 × 50 × 30 m cells (50 × 90 × 12 cells) and the P_O, P_D cells."""
+    from uamopt import build_grid, load_city, load_scenario, risk_field
+
+    scenario = load_scenario(root / "models" / "paper_case.toml")
+    grid = build_grid(scenario)
+    model = planning_model(scenario, risk_field(scenario, grid, load_city(scenario, grid)))
+    return model, endpoint_cell(model, P_O, "origin"), endpoint_cell(model, P_D, "destination")
+
+
+@pytest.mark.parametrize("stage", ["shortest", "initial"])
+def test_paper_case_searches_agree(paper_model, stage):
+    """About 3 s (shortest) and 8 s (initial): pure Python and networkx expand about 30 000 cells."""
+    model, start, goal = paper_model
+    problem = model.search_problem(stage)
+    results = solve_all(problem, start, goal)
+    assert_agree(problem, results, start, goal)
+    if stage == "shortest":
+        # the transport heuristic is the exact cost in free space: it must prune hard here
+        assert results[("fast", "transport")].expansions * 5 < results[("fast", "zero")].expansions
+        # the shortest track cannot be cheaper than the straight line between the cell centres
+        straight = np.abs(np.subtract(goal, start)) * np.asarray(model.field.grid.cell)
+        assert results[("fast", "zero")].cost >= model.c_h * math.hypot(*straight[:2]) - 1e-9
+
+
+def test_hand_checked_instance():
+    """2 × 2 × 2 free cells of 3 × 4 × 12 m, c_h' = 1, c_v' = 2, ω4 = 10, risk 1 everywhere (so the
+    risk term is 10 × the path length) and penalty 0.5 on entering the goal. The one space-diagonal
+    move, 13 m long, costs 5 + 2·12 + 10·13 + 0.5 = 159.5; every other route has the same
+    transport cost (≥ 5 + 24) but is at least 3 + √(4² + 12²) ≈ 15.6 m long."""
+    free = np.ones((2, 2, 2), dtype=bool)
+    penalty = np.zeros((2, 2, 2))
+    penalty[1, 1, 1] = 0.5
+    problem = SearchProblem(free, np.ones((2, 2, 2)), penalty, (3.0, 4.0, 12.0), 10.0, 1.0, 2.0)
+    for backend, heuristic in SEARCHES:
+        result = grid_search(problem, (0, 0, 0), (1, 1, 1), backend=backend, heuristic=heuristic)
+        assert result.cost == pytest.approx(159.5, rel=REL)
+        assert result.path.tolist() == [[0, 0, 0], [1, 1, 1]]
+
+
+# --- random small cities ------------------------------------------------------------------------
+
+
+@st.composite
+def random_cities(draw):
+    """A random airspace: passable mask, risk, buffer penalties, anisotropic cells, weights, and
+    passable start and goal cells. The arrays come from a drawn seed (fast to generate, and the
+    failing seed is printed)."""
+    shape = tuple(draw(st.integers(5, 15)) for _ in range(3))
+    seed = draw(st.integers(0, 2**32 - 1))
+    density = draw(st.floats(0.25, 1.0))
+    cell = tuple(draw(st.floats(0.5, 200.0)) for _ in range(3))
+    w_risk, c_h, c_v, mu = (draw(st.one_of(st.just(0.0), st.floats(0.01, 10.0))) for _ in range(4))
+    rng = np.random.default_rng(seed)
+    passable = rng.random(shape) < density
+    risk = rng.random(shape) * (rng.random(shape) < draw(st.floats(0.0, 1.0)))
+    penalty = mu * rng.integers(0, 27, shape).astype(float)  # μ·R(t), R(t) ≤ 26 for 3-cell boxes
+    start, goal = (tuple(int(rng.integers(n)) for n in shape) for _ in range(2))
+    passable[start] = passable[goal] = True
+    return SearchProblem(passable, risk, penalty, cell, w_risk, c_h, c_v), start, goal
+
+
+def connected(passable: np.ndarray, a, b) -> bool:
+    """Oracle: same face-connected component (see the module docstring)."""
+    labels, _ = ndimage.label(passable)  # default structure: 6-connectivity
+    return bool(labels[a] == labels[b])
+
+
+@settings(max_examples=60, deadline=None, derandomize=True)
+@given(random_cities())
+def test_random_cities_searches_agree(city):
+    problem, start, goal = city
+    searches = SEARCHES + (("networkx", "transport"),)
+    if not connected(problem.passable, start, goal):
+        event("goal walled off")
+        for backend, heuristic in searches:
+            with pytest.raises(NoTrackError):
+                grid_search(problem, start, goal, backend=backend, heuristic=heuristic)
+        return
+    event("goal reachable")
+    assert_agree(problem, solve_all(problem, start, goal, searches), start, goal)
+
+
+def test_random_cities_cover_both_outcomes():
+    """The strategy above really produces walled-off goals as well as reachable ones."""
+    outcomes = set()
+    for seed in range(40):
+        rng = np.random.default_rng(seed)
+        shape = tuple(int(n) for n in rng.integers(5, 16, 3))
+        passable = rng.random(shape) < rng.uniform(0.25, 1.0)
+        a, b = (tuple(int(rng.integers(n)) for n in shape) for _ in range(2))
+        passable[a] = passable[b] = True
+        outcomes.add(connected(passable, a, b))
+    assert outcomes == {True, False}
