@@ -177,7 +177,9 @@ def cmd_reproduce(args) -> int:
     from uamopt.outputs import check_out_dir, staged_output, write_json
     from uamopt.planning import planning_model
     from uamopt.plot_tracks import plot_tracks
-    from uamopt.report import network_section, risk_section, table2_section, table4_section, write_report
+    from uamopt.planning.pareto import plot_pareto, weight_sweep
+    from uamopt.report import (network_section, pareto_section, risk_section, table2_section, table4_section,
+                               write_report)
 
     scenario = _load(args)
     check_out_dir(args.out)
@@ -198,8 +200,13 @@ def cmd_reproduce(args) -> int:
         write_json(stage / "tracks.json", tracks)
         plot_tracks(fine_model, plan, stage / "tracks.png", title=f"{scenario.name}, {t2:g} m cells")
         table4 = [(side, plans[side][2], plans[side][3]) for side in scenario.tracks.table4_cells]
+        bar.set_description("pareto front")
+        fronts = {flag: weight_sweep(model, scenario.tracks.origin, scenario.tracks.destination, 9, buffer=flag)
+                  for flag in (False, True)}
+        plot_pareto(fronts[False], stage / "pareto.png", title=f"{scenario.name}: Eq. 10 trade-off (μ = 0)")
         sections = [risk_section(scenario, summary), table2_section(fine, fine_model, tracks),
-                    table4_section(scenario, table4), network_section(scenario, network["doc"])]
+                    table4_section(scenario, table4), pareto_section(scenario, model, fronts),
+                    network_section(scenario, network["doc"])]
         write_report(stage / "report.md", scenario, sections)
     print(f"report: {Path(args.out) / 'report.md'}")
     return 0

@@ -208,3 +208,24 @@ def network_section(scenario: Scenario, doc: dict) -> str:
         lines.append(f"| {name} | {r['layer_k'] if r['layer_k'] is not None else '-'} | {r['length_m']:.0f} | "
                      f"{r['transport_cost']:.2f} | {r['risk_cost']:.1f} |")
     return "\n".join(lines + ["", "![network](network.png)", ""]) + "\n"
+
+
+def pareto_section(scenario: Scenario, model, fronts: dict) -> str:
+    """Fig. 21 analogue: the (C_R, C_T) trade-off over ω4/ω5, without and with the buffer term."""
+    from uamopt.planning.pareto import non_dominated
+
+    g = model.field.grid
+    lines = [
+        "## Risk–cost trade-off: Fig. 21 analogue (Sec. 6.3.2)",
+        "",
+        f"P_O → P_D at {' × '.join(f'{c:g}' for c in g.cell)} m cells, weights ω4/ω5 swept (ω4 + ω5 = 1). "
+        "Non-dominated points of Eq. 10 alone (μ = 0), and with the safety-buffer term μ·R(t) of Eq. 34 "
+        f"(μ = {scenario.tracks.buffer_penalty:g}), which dominates the objective and collapses the front.",
+        "",
+        "| objective | ω4 | ω5 | C_R (Eq. 11) | C_T (¥, Eq. 12) |",
+        "|---|---|---|---|---|",
+    ]
+    for flag, label in ((False, "Eq. 10"), (True, "Eq. 10 + μ·R(t)")):
+        for p in non_dominated(fronts[flag]):
+            lines.append(f"| {label} | {p.w4:.4g} | {p.w5:.4g} | {p.risk_cost:.1f} | {p.transport_cost:.4f} |")
+    return "\n".join(lines + ["", "![pareto](pareto.png)", ""]) + "\n"

@@ -255,9 +255,12 @@ def flight_pair_gaps(
     n_buckets = int(b1.max()) + 1
     base, probe = _near_pairs(code[visit[row]] * n_buckets + bucket, offsets * n_buckets)  # type: ignore[misc]
     rb, rp = row[base], row[probe]
+    keep = flight[rb] < flight[rp]  # one orientation, no flight with itself: the most selective test first
+    base, rb, rp = base[keep], rb[keep], rp[keep]
+    keep = (bucket[base] == np.maximum(b0[rb], b0[rp])) & (w_lo[rb] < w_hi[rp]) & (w_lo[rp] < w_hi[rb])
+    rb, rp = rb[keep], rp[keep]
     fp, fq = flight[rb], flight[rp]
-    keep = ((fp < fq) & (flightset.aircraft_index[fp] != flightset.aircraft_index[fq])
-            & (bucket[base] == np.maximum(b0[rb], b0[rp])) & (w_lo[rb] < w_hi[rp]) & (w_lo[rp] < w_hi[rb]))
+    keep = flightset.aircraft_index[fp] != flightset.aircraft_index[fq]
     rb, rp, fp, fq = rb[keep], rp[keep], fp[keep], fq[keep]
     if len(rb) == 0:
         return np.zeros(0, dtype=np.int64), np.zeros(1, dtype=np.int64), np.zeros(0), np.zeros(0)
@@ -287,7 +290,7 @@ def candidate_pairs(flightset: FlightSet) -> tuple[np.ndarray, np.ndarray]:
     return p[keep], q[keep]
 
 
-MAX_TRACK_PAIRS = 30_000_000  # visit pairs of the track-level join before switching to flight level
+MAX_TRACK_PAIRS = 10_000_000  # visit pairs of the track-level join before switching to flight level (~0.5 GB)
 
 
 def conflict_table(flightset: FlightSet, *, max_track_pairs: int = MAX_TRACK_PAIRS) -> ConflictTable:
