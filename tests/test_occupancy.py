@@ -9,6 +9,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from uamopt.schedule import occupancy
 from uamopt.schedule.flights import Flight, FlightSet
 from uamopt.schedule.occupancy import (
     conflict_table,
@@ -140,7 +141,7 @@ def _clipped(fs, table):
 
 
 @pytest.mark.parametrize("radius", [0, 1])
-def test_flight_level_join_equals_track_level(radius):
+def test_flight_level_join_equals_track_level(radius, monkeypatch):
     """Forcing the per-flight join (as for many distinct tracks) gives the same constraints."""
     rng = np.random.default_rng(5)
     base = [[[5, 5, 15], [95, 5, 15]], [[95, 5, 25], [5, 5, 25]], [[50, 0, 15], [50, 90, 15]],
@@ -158,6 +159,14 @@ def test_flight_level_join_equals_track_level(radius):
     assert len(a) > 50 and a.keys() == b.keys()
     for k in a:
         np.testing.assert_allclose(a[k], b[k], atol=1e-9)
+    # many small chunks of groups and passes of rows (as for millions of pairs) give the same table
+    monkeypatch.setattr(occupancy, "OFFSET_LIMIT", 300.0)
+    monkeypatch.setattr(occupancy, "ROWS_PER_PASS", 500)  # the per-flight join in many passes
+    for forced in (None, 0):
+        small = conflict_table(fs) if forced is None else conflict_table(fs, max_track_pairs=0)
+        big = track_level if forced is None else flight_level
+        assert np.array_equal(small.p, big.p) and np.array_equal(small.q, big.q)
+        np.testing.assert_array_equal(small.intervals, big.intervals)
 
 
 def test_track_pair_gaps_same_track():

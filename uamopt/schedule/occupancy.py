@@ -49,6 +49,8 @@ import numpy as np
 from uamopt.schedule.flights import TIME_TOL_S, FlightSet
 
 MERGE_TOL_S = 1e-9  # breakpoints closer than this are one instant, s
+OFFSET_LIMIT = 1e8  # largest float offset used to separate groups in one vectorised pass, s
+ROWS_PER_PASS = 2_000_000  # visit rows joined at once by the per-flight join (bounds its memory)
 
 
 @dataclass(frozen=True, eq=False)
@@ -146,6 +148,14 @@ def flight_occupancies(flightset: FlightSet) -> tuple[list[Occupancy], np.ndarra
     return occupancies, key
 
 
+def _chunks(group_start: np.ndarray, span: float):
+    """Ranges [g0, g1) of consecutive groups whose float offsets (g − g0)·span stay ≤ 1e8, so the
+    offset values keep a precision of ~1.5e-8 s, far below ``TIME_TOL_S``."""
+    per_chunk = max(1, int(OFFSET_LIMIT // span))
+    n = len(group_start) - 1
+    return [(g0, min(g0 + per_chunk, n)) for g0 in range(0, n, per_chunk)]
+
+
 def _group_merge(group: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Union of open intervals per group: returns (group, lo, hi) sorted, disjoint per group.
 
@@ -153,13 +163,17 @@ def _group_merge(group: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> tuple[np.
     """
     order = np.lexsort((lo, group))
     group, lo, hi = group[order], lo[order], hi[order]
-    # running max of hi within each group: offset each group above the previous one
     rank = np.concatenate([[0], np.cumsum(group[1:] != group[:-1])])
-    span = float(np.max(hi) - np.min(lo)) + 1.0
+    bounds = np.searchsorted(rank, np.arange(rank[-1] + 2))  # rows of group rank g: bounds[g]:bounds[g+1]
     base = float(np.min(lo))
-    run = np.maximum.accumulate((hi - base) + rank * span) - rank * span + base
+    span = float(np.max(hi) - base) + 1.0
     start = np.ones(len(lo), dtype=bool)
-    start[1:] = (rank[1:] != rank[:-1]) | (lo[1:] >= run[:-1] + TIME_TOL_S)
+    for g0, g1 in _chunks(bounds, span):
+        # running max of hi within each group: each group offset above the previous one
+        rows = slice(bounds[g0], bounds[g1])
+        off = (rank[rows] - g0) * span
+        run = np.maximum.accumulate((hi[rows] - base) + off) - off + base
+        start[rows][1:] = (rank[rows][1:] != rank[rows][:-1]) | (lo[rows][1:] >= run[:-1] + TIME_TOL_S)
     idx = np.flatnonzero(start)
     return group[idx], lo[idx], np.maximum.reduceat(hi, idx)
 
@@ -253,12 +267,26 @@ def flight_pair_gaps(
     row = np.repeat(np.arange(len(flight)), reps)
     bucket = np.repeat(b0 - np.cumsum(reps) + reps, reps) + np.arange(reps.sum())
     n_buckets = int(b1.max()) + 1
-    base, probe = _near_pairs(code[visit[row]] * n_buckets + bucket, offsets * n_buckets)  # type: ignore[misc]
-    rb, rp = row[base], row[probe]
-    keep = flight[rb] < flight[rp]  # one orientation, no flight with itself: the most selective test first
-    base, rb, rp = base[keep], rb[keep], rp[keep]
-    keep = (bucket[base] == np.maximum(b0[rb], b0[rp])) & (w_lo[rb] < w_hi[rp]) & (w_lo[rp] < w_hi[rb])
-    rb, rp = rb[keep], rp[keep]
+    # rows join only within one bucket: process ranges of buckets of ≤ ROWS_PER_PASS rows each
+    by_bucket = np.argsort(bucket, kind="stable")
+    row, bucket = row[by_bucket], bucket[by_bucket]
+    cuts = np.searchsorted(bucket, np.arange(n_buckets + 1))
+    found_b, found_p = [], []
+    lo_cut = 0
+    while lo_cut < n_buckets:
+        hi_cut = max(lo_cut + 1, int(np.searchsorted(cuts, cuts[lo_cut] + ROWS_PER_PASS, side="right")) - 1)
+        hi_cut = min(hi_cut, n_buckets)
+        part = slice(cuts[lo_cut], cuts[hi_cut])
+        rows, bk = row[part], bucket[part]
+        base, probe = _near_pairs(code[visit[rows]] * n_buckets + bk, offsets * n_buckets)  # type: ignore[misc]
+        rb, rp = rows[base], rows[probe]
+        keep = flight[rb] < flight[rp]  # one orientation, no flight with itself: the most selective test first
+        base, rb, rp = base[keep], rb[keep], rp[keep]
+        keep = (bk[base] == np.maximum(b0[rb], b0[rp])) & (w_lo[rb] < w_hi[rp]) & (w_lo[rp] < w_hi[rb])
+        found_b.append(rb[keep])
+        found_p.append(rp[keep])
+        lo_cut = hi_cut
+    rb, rp = np.concatenate(found_b), np.concatenate(found_p)
     fp, fq = flight[rb], flight[rp]
     keep = flightset.aircraft_index[fp] != flightset.aircraft_index[fq]
     rb, rp, fp, fq = rb[keep], rp[keep], fp[keep], fq[keep]
@@ -332,17 +360,26 @@ def _prune_to_ranges(flightset, p, q, grp, pair_code, ptr, lo, hi) -> ConflictTa
     dep, upper = flightset.planned_departure_s, flightset.delay_upper_s
     range_lo = dep[q] - dep[p] - upper[p] - TIME_TOL_S
     range_hi = dep[q] - dep[p] + upper[q] + TIME_TOL_S
-    # One sorted key per interval: group·span + value. Groups occupy disjoint stretches, so one
-    # searchsorted finds, within each pair's group, the first interval with hi > range_lo and the
-    # first with lo ≥ range_hi (intervals are sorted and disjoint). Float round-off of the key
-    # (< 1e-7 s for 10⁵ groups) is below the TIME_TOL_S widening, so nothing is lost.
+    # One sorted key per interval: (group − g0)·span + value, per chunk of groups. Groups occupy
+    # disjoint stretches, so one searchsorted finds, within each pair's group, the first interval
+    # with hi > range_lo and the first with lo ≥ range_hi (intervals are sorted and disjoint).
     base, top = float(lo.min()), float(hi.max())
     span = top - base + 4.0
-    group_of = np.repeat(np.arange(len(pair_code)), np.diff(ptr)) * span
-    key_lo, key_hi = group_of + (lo - base), group_of + (hi - base)
-    offset = grp * span - base
-    first = np.searchsorted(key_hi, offset + np.clip(range_lo, base - 1.0, top + 1.0), side="right")
-    last = np.searchsorted(key_lo, offset + np.clip(range_hi, base - 1.0, top + 1.0), side="left")
+    lo_key, hi_key = lo - base, hi - base
+    order = np.argsort(grp, kind="stable")
+    q_lo = np.clip(range_lo, base - 1.0, top + 1.0) - base
+    q_hi = np.clip(range_hi, base - 1.0, top + 1.0) - base
+    first = np.empty(len(grp), dtype=np.int64)
+    last = np.empty(len(grp), dtype=np.int64)
+    group_of = np.repeat(np.arange(len(pair_code)), np.diff(ptr))
+    for g0, g1 in _chunks(ptr, span):
+        rows = slice(ptr[g0], ptr[g1])
+        off = (group_of[rows] - g0) * span
+        a, b = np.searchsorted(grp[order], [g0, g1])
+        qs = order[a:b]
+        q_off = (grp[qs] - g0) * span
+        first[qs] = ptr[g0] + np.searchsorted(off + hi_key[rows], q_off + q_lo[qs], side="right")
+        last[qs] = ptr[g0] + np.searchsorted(off + lo_key[rows], q_off + q_hi[qs], side="left")
     meet = last > first
     p, q, first, last = p[meet], q[meet], first[meet], last[meet]
     order = np.lexsort((q, p))
