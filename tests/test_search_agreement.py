@@ -55,8 +55,8 @@ def assert_valid_track(problem: SearchProblem, result, start, goal) -> None:
     for u, d in zip(path[:-1], step):
         lo, hi = np.minimum(u, u + d), np.maximum(u, u + d) + 1
         box = problem.passable[lo[0]:hi[0], lo[1]:hi[1], lo[2]:hi[2]]
-        assert box.all(), f"move {tuple(u)} → {tuple(u + d)} cuts the corner of an impassable cell"
-    assert path_cost(problem, path) == pytest.approx(result.cost, rel=REL, abs=1e-12)
+        assert box.all(), f"move {u.tolist()} → {(u + d).tolist()} cuts the corner of an impassable cell"
+    assert path_cost(problem, path) == pytest.approx(result.cost, rel=REL, abs=1e-12), "cost recomputed from the path"
 
 
 def solve_all(problem: SearchProblem, start, goal, searches=SEARCHES) -> dict:

@@ -3,8 +3,9 @@
 Airspace layering (Sec. 4.1.2), ``tracks.layering = "direction"`` (default): the two directions of
 a route fly on separate cruise layers. The direction from the first-named vertiport to the second
 flies the cell layer that holds the cruise altitude (120 m), starting and ending at that altitude;
-the opposite direction flies the layer above, at cruise altitude + Δz. Each direction's search is
-confined to its layer, so the two directions never share a cell. ``"none"`` lets both directions
+the opposite direction flies r + 1 layers higher (r = ``schedule.conflict_radius``, so 60 m higher
+with 30 m layers and the default 3×3×3 conflict zone), starting and ending at that layer's floor.
+Each direction's search is confined to its layer, so the two directions never conflict. ``"none"`` lets both directions
 use the whole altitude band.
 
 ``network.json``::
@@ -37,13 +38,16 @@ def route_pairs(model: PlanningModel) -> list[tuple[str, str]]:
 
 
 def direction_layers(model: PlanningModel) -> tuple[int, int]:
-    """Cell layers of the two directions: the cruise altitude's layer, and the one above."""
+    """Cell layers of the two directions: the cruise altitude's layer, and the first layer above it
+    outside its conflict zone (r + 1 layers up, r = ``schedule.conflict_radius``), so opposite
+    directions of a route never conflict."""
     grid = model.field.grid
     k = int(np.floor(model.scenario.network.cruise_altitude_m / grid.cell[2]))
-    if k + 1 >= grid.shape[2]:
-        raise NoTrackError("no cell layer above the cruise altitude for the return direction",
-                           "network.cruise_altitude_m", "lower the cruise altitude or raise grid.extent z")
-    return k, k + 1
+    up = k + model.scenario.schedule.conflict_radius + 1
+    if up >= grid.shape[2] or up not in set(model.field.band_layers().tolist()):
+        raise NoTrackError("no cell layer in the altitude band for the return direction",
+                           "network.cruise_altitude_m", "lower the cruise altitude or widen the band")
+    return k, up
 
 
 def _confined(model: PlanningModel, k: int) -> PlanningModel:
@@ -64,7 +68,7 @@ def plan_network(model: PlanningModel, progress=None) -> dict[str, tuple[str, st
     out: dict[str, tuple[str, str, TrackPlan, int | None]] = {}
     for a, b in route_pairs(model):
         for origin, destination, up in ((a, b, False), (b, a, True)):
-            z = cruise + (dz if (layered and up) else 0.0)
+            z = cruise + ((k_back - k_out) * dz if (layered and up) else 0.0)
             k = (k_back if up else k_out) if layered else None
             sub = confined[k] if layered else model
             p, q = ports[origin], ports[destination]

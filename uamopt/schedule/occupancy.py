@@ -50,7 +50,7 @@ from uamopt.schedule.flights import TIME_TOL_S, FlightSet
 
 MERGE_TOL_S = 1e-9  # breakpoints closer than this are one instant, s
 OFFSET_LIMIT = 1e8  # largest float offset used to separate groups in one vectorised pass, s
-ROWS_PER_PASS = 2_000_000  # visit rows joined at once by the per-flight join (bounds its memory)
+ROWS_PER_PASS = 500_000  # visit rows joined at once by the per-flight join (bounds its memory)
 
 
 @dataclass(frozen=True, eq=False)
@@ -271,7 +271,7 @@ def flight_pair_gaps(
     by_bucket = np.argsort(bucket, kind="stable")
     row, bucket = row[by_bucket], bucket[by_bucket]
     cuts = np.searchsorted(bucket, np.arange(n_buckets + 1))
-    found_b, found_p = [], []
+    found: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
     lo_cut = 0
     while lo_cut < n_buckets:
         hi_cut = max(lo_cut + 1, int(np.searchsorted(cuts, cuts[lo_cut] + ROWS_PER_PASS, side="right")) - 1)
@@ -283,17 +283,17 @@ def flight_pair_gaps(
         keep = flight[rb] < flight[rp]  # one orientation, no flight with itself: the most selective test first
         base, rb, rp = base[keep], rb[keep], rp[keep]
         keep = (bk[base] == np.maximum(b0[rb], b0[rp])) & (w_lo[rb] < w_hi[rp]) & (w_lo[rp] < w_hi[rb])
-        found_b.append(rb[keep])
-        found_p.append(rp[keep])
+        rb, rp = rb[keep], rp[keep]
+        fp, fq = flight[rb], flight[rp]
+        keep = flightset.aircraft_index[fp] != flightset.aircraft_index[fq]
+        rb, rp, fp, fq = rb[keep], rp[keep], fp[keep], fq[keep]
+        if len(rb):  # merge now: flights on near-identical tracks give hundreds of visit pairs each
+            vb, vp = visit[rb], visit[rp]
+            found.append(_group_merge(fp * n + fq, t_in[vb] - t_out[vp], t_out[vb] - t_in[vp]))
         lo_cut = hi_cut
-    rb, rp = np.concatenate(found_b), np.concatenate(found_p)
-    fp, fq = flight[rb], flight[rp]
-    keep = flightset.aircraft_index[fp] != flightset.aircraft_index[fq]
-    rb, rp, fp, fq = rb[keep], rp[keep], fp[keep], fq[keep]
-    if len(rb) == 0:
+    if not found:
         return np.zeros(0, dtype=np.int64), np.zeros(1, dtype=np.int64), np.zeros(0), np.zeros(0)
-    vb, vp = visit[rb], visit[rp]
-    g, lo, hi = _group_merge(fp * n + fq, t_in[vb] - t_out[vp], t_out[vb] - t_in[vp])
+    g, lo, hi = _group_merge(*(np.concatenate(parts) for parts in zip(*found)))
     pair_code, starts = np.unique(g, return_index=True)
     return pair_code, np.append(starts, len(g)).astype(np.int64), lo, hi
 

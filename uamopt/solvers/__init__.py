@@ -1,0 +1,95 @@
+"""Solvers behind one interface (linopy/PyPSA pattern): ``solve(problem, profile) -> Schedule``.
+
+A solver never builds the model: it takes a :class:`~uamopt.schedule.SchedulingProblem` as data
+and returns a :class:`~uamopt.schedule.Schedule` (status, objective, bound, gap, time, seed).
+Profiles are TOML files in ``solvers/`` naming a solver and its options::
+
+    solver = "highs"        # greedy | ga | soa | highs | cpsat
+    time_limit_s = 60.0
+    seed = 0
+    threads = 2
+    [options]               # solver-specific (see each module's docstring)
+    mip_rel_gap = 0.0
+"""
+
+from __future__ import annotations
+
+import importlib
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from uamopt.errors import ScenarioError, UamoptError
+
+if TYPE_CHECKING:
+    from uamopt.schedule import Schedule, SchedulingProblem
+
+#: solver name -> module implementing ``solve(problem, profile) -> Schedule``
+SOLVERS = {
+    "greedy": "uamopt.solvers.greedy",
+    "ga": "uamopt.solvers.genetic",
+    "soa": "uamopt.solvers.genetic",
+    "highs": "uamopt.solvers.milp",
+    "cpsat": "uamopt.solvers.cpsat",
+}
+PROFILE_DIR = Path(__file__).resolve().parents[2] / "solvers"
+_KEYS = {"solver", "time_limit_s", "seed", "threads", "options", "description"}
+
+
+@dataclass(frozen=True)
+class SolverProfile:
+    """A solver and its options; ``name`` is the profile's file stem."""
+
+    solver: str
+    name: str = ""
+    time_limit_s: float = 60.0
+    seed: int = 0
+    threads: int = 2
+    options: dict = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        if self.solver not in SOLVERS:
+            raise UamoptError(f"unknown solver '{self.solver}'", f"profile {self.name or self.solver}",
+                              f"use one of {', '.join(SOLVERS)}")
+        if not self.time_limit_s > 0:
+            raise UamoptError(f"time_limit_s must be positive, got {self.time_limit_s}", f"profile {self.name}",
+                              "give a time limit in seconds")
+        if self.threads < 1:
+            raise UamoptError(f"threads must be at least 1, got {self.threads}", f"profile {self.name}", "use 1 or more")
+
+
+def load_profile(name_or_path: str | Path) -> SolverProfile:
+    """A profile by path (``solvers/highs.toml``) or bare name (``highs``, looked up in solvers/)."""
+    text = str(name_or_path)
+    path = Path(text)
+    if not path.suffix:
+        path = PROFILE_DIR / f"{text}.toml"
+        if not path.is_file() and text in SOLVERS:
+            return SolverProfile(solver=text, name=text)
+    if not path.is_file():
+        raise UamoptError(f"solver profile not found: {text}", "--solver",
+                          f"give a profile file or one of {', '.join(sorted(p.stem for p in PROFILE_DIR.glob('*.toml')))}")
+    try:
+        raw = tomllib.loads(path.read_text(encoding="utf-8"))
+    except tomllib.TOMLDecodeError as exc:
+        raise ScenarioError(f"malformed TOML: {exc}", str(path), "fix the syntax at that line") from None
+    unknown = set(raw) - _KEYS
+    if unknown:
+        raise ScenarioError(f"unknown key '{sorted(unknown)[0]}'", str(path), f"valid keys are {', '.join(sorted(_KEYS))}")
+    if "solver" not in raw:
+        raise ScenarioError("missing key 'solver'", str(path), f"name one of {', '.join(SOLVERS)}")
+    try:
+        return SolverProfile(solver=str(raw["solver"]), name=path.stem, time_limit_s=float(raw.get("time_limit_s", 60.0)),
+                             seed=int(raw.get("seed", 0)), threads=int(raw.get("threads", 2)),
+                             options=dict(raw.get("options", {})))
+    except (TypeError, ValueError) as exc:
+        raise ScenarioError(f"invalid value in solver profile: {exc}", str(path), "see uamopt/solvers/__init__.py") from None
+
+
+def solve(problem: "SchedulingProblem", profile: SolverProfile | str) -> "Schedule":
+    """Run the profile's solver on the problem."""
+    if not isinstance(profile, SolverProfile):
+        profile = load_profile(profile)
+    module = importlib.import_module(SOLVERS[profile.solver])
+    return module.solve(problem, profile)
