@@ -212,6 +212,119 @@ def cmd_reproduce(args) -> int:
     return 0
 
 
+def _scheduling_problem(scenario, args, bar):
+    """The flight set (given, or generated on the planned or given network) and its model."""
+    from uamopt.grid import build_grid
+    from uamopt.planning import planning_model
+    from uamopt.planning.network import load_network, network_document, plan_network
+    from uamopt.schedule import build_problem, generate_plan, load_flights
+    from uamopt.stages import compute_risk
+
+    grid = build_grid(scenario)
+    if args.network:
+        network = load_network(args.network)
+    elif args.flights:
+        network = None  # self-contained flights need no network; named routes then fail clearly
+    else:
+        bar.set_description("network")
+        model = planning_model(scenario, compute_risk(scenario).field)
+        doc = network_document(model, plan_network(model))
+        network = {k: np.asarray(v["waypoints"]) for k, v in doc["routes"].items()}
+    bar.update(1)
+    if args.flights:
+        flights = load_flights(args.flights, scenario, grid, network)
+    else:
+        sc = scenario.schedule
+        seed = sc.plan_seed if args.seed is None else args.seed
+        flights = generate_plan(scenario, network, seed, service_s=sc.service_s,
+                                first_departure_window_s=sc.first_departure_window_s)
+    bar.set_description("conflicts")
+    problem = build_problem(flights, scenario, objective=scenario.schedule.objective)
+    bar.update(1)
+    return problem
+
+
+def cmd_schedule(args) -> int:
+    from uamopt.outputs import check_out_dir
+    from uamopt.schedule import write_schedule
+    from uamopt.schedule.verify import verify_dir
+    from uamopt.solvers import load_profile, solve
+
+    scenario = _load(args)
+    profile = load_profile(args.solver)
+    check_out_dir(args.out)
+    with _progress(3, "schedule") as bar:
+        problem = _scheduling_problem(scenario, args, bar)
+        bar.set_description(profile.solver)
+        schedule = solve(problem, profile)
+        bar.update(1)
+    write_schedule(args.out, problem, schedule)
+    problems = verify_dir(args.out)
+    print(f"{schedule.solver}: {schedule.status}, objective {schedule.objective}, operated {schedule.operated_count}, "
+          f"cancelled {schedule.cancelled}, total delay {schedule.total_delay_s:.1f} s, "
+          f"{schedule.solve_seconds:.2f} s -> {Path(args.out) / 'schedule.csv'}")
+    if problems:  # a solver bug, never bad input: say so loudly
+        sys.stderr.write(f"error: the schedule failed verification ({len(problems)} violations, {args.out}): "
+                         f"{problems[0]}\n")
+        return 1
+    return 0
+
+
+def cmd_verify(args) -> int:
+    from uamopt.schedule.verify import verify_dir
+
+    problems = verify_dir(args.dir)
+    for line in problems:
+        print(line)
+    if problems:
+        print(f"{len(problems)} violations")
+        return 1
+    print(f"feasible and conflict-free: {args.dir}")
+    return 0
+
+
+def cmd_bench(args) -> int:
+    import tempfile
+
+    from uamopt.outputs import check_out_dir, staged_output
+    from uamopt.scenario import load_scenario
+    from uamopt.schedule import write_schedule
+    from uamopt.schedule.verify import verify_dir
+    from uamopt.solvers import load_profile, solve
+
+    profiles = [load_profile(p) for p in args.solver]
+    scenarios = [load_scenario(path, args.set) for path in args.scenario]
+    check_out_dir(args.out)
+    rows = []
+    with _progress(len(scenarios) * (2 + len(profiles)), "bench") as bar:
+        for scenario in scenarios:
+            problem = _scheduling_problem(scenario, args, bar)
+            for profile in profiles:
+                bar.set_description(f"{scenario.name}: {profile.name}")
+                schedule = solve(problem, profile)
+                with tempfile.TemporaryDirectory() as tmp:
+                    write_schedule(Path(tmp) / "s", problem, schedule)
+                    verified = not verify_dir(Path(tmp) / "s")
+                rows.append({"instance": scenario.name, "flights": problem.n_flights, "profile": profile.name,
+                             "solver": profile.solver, "status": schedule.status, "objective": schedule.objective,
+                             "bound": schedule.bound, "gap": schedule.gap, "operated": schedule.operated_count,
+                             "cancelled": schedule.cancelled, "total_delay_s": schedule.total_delay_s,
+                             "seconds": schedule.solve_seconds, "verified": "yes" if verified else "NO"})
+                bar.update(1)
+    keys = list(rows[0])
+    with staged_output(args.out) as stage:
+        with open(stage / "bench.csv", "w", encoding="utf-8") as fh:
+            fh.write(",".join(keys) + "\n")
+            for r in rows:
+                fh.write(",".join("" if r[k] is None else str(r[k]) for k in keys) + "\n")
+        fmt = lambda v: "-" if v is None else (f"{v:.6g}" if isinstance(v, float) else str(v))
+        lines = ["| " + " | ".join(keys) + " |", "|" + "---|" * len(keys)]
+        lines += ["| " + " | ".join(fmt(r[k]) for k in keys) + " |" for r in rows]
+        (stage / "bench.md").write_text("\n".join(lines) + "\n", encoding="utf-8")
+    print("\n".join(lines))
+    return 0 if all(r["verified"] == "yes" for r in rows) else 1
+
+
 def _toml_list(values) -> str:
     return "[" + ",".join(f"{float(v)!r}" for v in values) + "]"
 
@@ -235,6 +348,24 @@ def build_parser() -> argparse.ArgumentParser:
     plan.add_argument("--from", dest="origin", metavar="X,Y,Z", help="origin, m (default: tracks.origin, P_O)")
     plan.add_argument("--to", dest="destination", metavar="X,Y,Z", help="destination, m (default: tracks.destination, P_D)")
     command("network", cmd_network, "plan one track per route and direction: network.json, network.png", "out/network")
+    sched = command("schedule", cmd_schedule, "schedule the flights: flights.json, schedule.csv, summary.json", "out/schedule")
+    for p in (sched,):
+        p.add_argument("--solver", required=True, metavar="PROFILE", help="solver profile: solvers/NAME.toml or NAME")
+    bench = sub.add_parser("bench", help="benchmark solver profiles on scenarios: bench.csv, bench.md",
+                           description="benchmark solver profiles on scenarios: bench.csv, bench.md")
+    bench.add_argument("scenario", nargs="+", help="scenario TOML files")
+    bench.add_argument("--solver", nargs="+", required=True, metavar="PROFILE", help="solver profiles")
+    bench.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="override keys of every scenario")
+    bench.add_argument("--out", default="out/bench", help="output folder (default: out/bench)")
+    bench.set_defaults(func=cmd_bench)
+    for p in (sched, bench):
+        p.add_argument("--flights", help="flights.json to schedule instead of the generated plan")
+        p.add_argument("--network", help="network.json whose routes the flights fly (default: planned now)")
+        p.add_argument("--seed", type=int, help="seed of the generated plan (default: schedule.plan_seed)")
+    verify = sub.add_parser("verify", help="check a schedule folder independently: exit 0 iff feasible and conflict-free",
+                            description="check a schedule folder independently: exit 0 iff feasible and conflict-free")
+    verify.add_argument("dir", help="folder with flights.json and schedule.csv")
+    verify.set_defaults(func=cmd_verify)
     command("reproduce", cmd_reproduce, "run every stage that applies and write report.md with figures", "out/reproduce")
     return parser
 

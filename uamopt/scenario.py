@@ -215,6 +215,14 @@ class ScheduleConfig(_Section):
     flights: Annotated[int, Field(ge=1)] = Field(120, description="f, planned flights")
     time_step_s: PositiveFloat = Field(10.0, description="ΔT_a, s (Table B.3)")
     conflict_radius: Annotated[int, Field(ge=0)] = Field(1, description="r: conflict zone of (2r+1)³ cells")
+    service_s: PositiveFloat = Field(3600.0, description="T_f − T_s, the service window, s (Eq. 23: gives F = 6)")
+    first_departure_window_s: NonNegFloat = Field(
+        600.0, description="first planned departures of the aircraft are drawn in [T_s, T_s + window], s"
+    )
+    plan_seed: int = Field(0, description="seed of the initial flight plan generator")
+    objective: Literal["weighted", "lexicographic"] = Field(
+        "weighted", description="Eq. 20 (ω6 T_d − ω7 S), or most flights first then least delay"
+    )
 
 
 class Scenario(_Section):
