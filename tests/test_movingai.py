@@ -22,8 +22,9 @@ from uamopt.planning.movingai import (
     read_scenarios,
 )
 
-# /work/shared sits beside the repository root (CI clones the repo with shared/ next to it).
-BENCHMARKS = Path(__file__).resolve().parents[2] / "shared" / "benchmarks" / "movingai"
+# The public benchmark files (N. Sturtevant's Moving AI grids; credits in tests/data/movingai/README.md)
+# ship with the tests; the shared/ folder beside the repository holds the same files.
+BENCHMARKS = Path(__file__).resolve().parent / "data" / "movingai"
 MAPS = ("arena.map", "maze512-32-9.map")
 SAMPLE_SIZE = 40
 TOLERANCE = 1e-3  # the .scen files print lengths to 5-8 decimals
@@ -34,8 +35,7 @@ def benchmark(request):
     """(map, its problem, all scenario rows) for one benchmark map."""
     folder = BENCHMARKS
     if not folder.is_dir():
-        pytest.fail(f"Moving AI benchmarks not found at {folder}: the repository expects shared/benchmarks/movingai "
-                    "beside its root (clone it next to the shared/ folder)", pytrace=False)
+        pytest.fail(f"Moving AI benchmarks not found at {folder}", pytrace=False)
     octile = read_map(folder / request.param)
     rows = read_scenarios(folder / f"{request.param}.scen")
     return octile, movingai_problem(octile), rows

@@ -4,7 +4,7 @@ Run on demand (not collected by pytest; several minutes, most of it the 8010 maz
 
     .venv/bin/python tests/benchmarks/bench_planning.py [--movingai-rows N] [--nx-cell 20] [--cells 10 5]
 
-(i)   Moving AI: every scenario row of both maps in shared/benchmarks/movingai (beside the repo
+(i)   Moving AI: every scenario row of both maps in tests/data/movingai (as in shared/benchmarks, beside the repo
       root), fast backend with the transport heuristic: rows matching the optimal length to 1e-3,
       and the total time.
 (ii)  The paper case at 10 m cells, P_O → P_D: time of ``planning_model`` and of ``plan_track``
@@ -40,7 +40,7 @@ from uamopt.planning import SearchProblem, grid_search, plan_track, planning_mod
 from uamopt.planning.movingai import movingai_problem, read_map, read_scenarios  # noqa: E402
 from uamopt.planning.tracks import endpoint_cell  # noqa: E402
 
-MOVINGAI = ROOT.parent / "shared" / "benchmarks" / "movingai"
+MOVINGAI = ROOT / "tests" / "data" / "movingai"
 MAPS = ("arena.map", "maze512-32-9.map")
 SCENARIO = ROOT / "models" / "paper_case.toml"
 P_O, P_D = (300.0, 300.0, 120.0), (2220.0, 4220.0, 120.0)  # Table B.3

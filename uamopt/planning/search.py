@@ -263,7 +263,7 @@ def _python(problem: SearchProblem, start: int, goal: int, use_heuristic: bool):
     path = [goal_t]
     while path[-1] != start_c:
         path.append(parent[path[-1]])
-    return np.asarray(path[::-1], dtype=np.int64), g[goal_t], expansions
+    return np.asarray(path[::-1], dtype=np.int64), float(g[goal_t]), expansions
 
 
 def _networkx(problem: SearchProblem, start: int, goal: int, use_heuristic: bool):
@@ -330,6 +330,8 @@ def grid_search(problem: SearchProblem, start: tuple[int, int, int], goal: tuple
     if heuristic not in ("transport", "zero"):
         raise ValueError(f"heuristic must be 'transport' or 'zero', got {heuristic!r}")
     for name, c in (("start", start), ("goal", goal)):
+        if len(c) != 3 or not all(0 <= int(v) < n for v, n in zip(c, problem.shape)):
+            raise ValueError(f"{name} {tuple(c)} is not a cell of the grid of shape {problem.shape}")
         if not problem.passable[tuple(c)]:
             raise NoTrackError(f"the {name} cell {tuple(int(v) for v in c)} is not passable", "track search",
                                "move it out of buildings, no-fly zones and the clearance margin")
