@@ -200,11 +200,18 @@ def cmd_reproduce(args) -> int:
         write_json(stage / "tracks.json", tracks)
         plot_tracks(fine_model, plan, stage / "tracks.png", title=f"{scenario.name}, {t2:g} m cells")
         table4 = [(side, plans[side][2], plans[side][3]) for side in scenario.tracks.table4_cells]
+        bar.set_description("buffer variant")
+        other = "share" if scenario.tracks.buffer_measure == "count" else "count"
+        variant = scenario.with_overrides([f"tracks.buffer_measure={other}"])
+        v_scenario, v_model, v_plan, _ = _plan_at(variant, t2, run.grid.extent)
+        v_tracks = {**v_plan.as_dict()}
         bar.set_description("pareto front")
         fronts = {flag: weight_sweep(model, scenario.tracks.origin, scenario.tracks.destination, 9, buffer=flag)
                   for flag in (False, True)}
         plot_pareto(fronts[False], stage / "pareto.png", title=f"{scenario.name}: Eq. 10 trade-off (μ = 0)")
         sections = [risk_section(scenario, summary), table2_section(fine, fine_model, tracks),
+                    table2_section(v_scenario, v_model, v_tracks, figure=False,
+                                   title=f"Table 2 analogue with the variant tracks.buffer_measure = \"{other}\""),
                     table4_section(scenario, table4), pareto_section(scenario, model, fronts),
                     network_section(scenario, network["doc"])]
         write_report(stage / "report.md", scenario, sections)

@@ -117,7 +117,8 @@ def straight_segment_cost(scenario: Scenario, length_m: float = 4365.0) -> float
     return transport_rates(scenario)[0] * length_m
 
 
-def table2_section(scenario: Scenario, model, tracks: dict) -> str:
+def table2_section(scenario: Scenario, model, tracks: dict, title: str = "Track planning: Table 2 analogue (Sec. 6.2, Fig. 18)",
+                   figure: bool = True) -> str:
     """Table 2 analogue beside the paper's figures, with the cumulative computing time."""
     st = tracks["stages"]
     names = ("shortest", "initial", "equivalent", "optimal")
@@ -137,7 +138,7 @@ def table2_section(scenario: Scenario, model, tracks: dict) -> str:
     g = model.field.grid
     o, d = tracks["origin"], tracks["destination"]
     lines = [
-        "## Track planning: Table 2 analogue (Sec. 6.2, Fig. 18)",
+        f"## {title}",
         "",
         f"P_O = ({', '.join(f'{v:g}' for v in o)}) → P_D = ({', '.join(f'{v:g}' for v in d)}) m, cells "
         f"{' × '.join(f'{c:g}' for c in g.cell)} m, ω4 = {scenario.tracks.weights[0]:g}, ω5 = {scenario.tracks.weights[1]:g}, "
@@ -166,9 +167,7 @@ def table2_section(scenario: Scenario, model, tracks: dict) -> str:
         f"Check of Eq. 12–13 (MODEL_NOTES): a straight level 4365 m segment with m_p = {scenario.aircraft.payload_kg:g} kg "
         f"costs ¥{straight_segment_cost(scenario):.4f} (paper's shortest track: ¥27.1527).",
         "",
-        "![tracks](tracks.png)",
-        "",
-    ]
+    ] + (["![tracks](tracks.png)", ""] if figure else [])
     return "\n".join(lines) + "\n"
 
 

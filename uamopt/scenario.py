@@ -173,6 +173,10 @@ class TracksConfig(_Section):
     weights: tuple[NonNegFloat, NonNegFloat] = Field((0.5, 0.5), description="(ω4, ω5) risk and transport (Eq. 10)")
     clearance_m: NonNegFloat = Field(50.0, description="s_min, building clearance, m (Eq. 15)")
     buffer_penalty: NonNegFloat = Field(100.0, description="μ, safety-buffer shell penalty (Eq. 35)")
+    buffer_measure: Literal["count", "share"] = Field(
+        "count", description="R(t) of Eq. 35: the number of unsafe cells on the buffer's outer shell (MODEL_NOTES), "
+        "or their share of the shell's cells (a variant that does not grow with finer cells)"
+    )
     risk_model: Literal["binary", "continuous"] = Field("binary", description="Eq. 9 field or Eq. 8 field")
     origin: tuple[float, float, float] = Field(
         (300.0, 300.0, 120.0), description="P_O, default origin of `uamopt plan`, m (Table B.3: (30, 30, 120) in 10 m units)"

@@ -6,6 +6,7 @@ Readings (MODEL_NOTES, paper Sec. 5.1):
   the band of Eq. 14, and centre at least s_min from the centre of every obstacle cell (Eq. 15).
   A continuous track is admissible when every point of it lies in admissible cells.
 - Safety buffer (Eqs. 34–35): a box of n_s cells per axis around the cell entered,
+  (``tracks.buffer_measure = "share"`` divides R(t) by the shell's cell count: a variant),
   n_s = ⌈s_min/Δ⌉·2 + 1 (50 m cells → 3, 30 m layers → 5); R(t) counts the unsafe cells (Eq. 9:
   risky, obstacle or no-fly) on the box's outer shell; the move pays μ·R(t). Cells outside the
   grid count as unsafe. Computed for all cells at once with a 3-D summed-area table.
@@ -105,7 +106,7 @@ class PlanningModel:
     field: RiskField
     admissible: np.ndarray  # bool (nx, ny, nz)
     risk: np.ndarray  # R used in Eq. 11 (binary or continuous), 0 in inadmissible cells
-    shell_count: np.ndarray  # R(t) of Eq. 35 (int)
+    shell_count: np.ndarray  # R(t) of Eq. 35: unsafe shell cells, or their share (tracks.buffer_measure)
     n_s: tuple[int, int, int]
     c_h: float  # c_h c_e τ, ¥/m
     c_v: float  # c_v c_e τ, ¥/m
@@ -156,6 +157,11 @@ def planning_model(scenario: Scenario, field: RiskField) -> PlanningModel:
         risk = np.nan_to_num(field.risk, nan=0.0)
     risk = np.where(admissible, risk, 0.0)
     n_s = buffer_cells(grid.cell, s_min)
-    shell = buffer_shell_count(field.unsafe, n_s)
+    shell = buffer_shell_count(field.unsafe, n_s).astype(float)
+    if scenario.tracks.buffer_measure == "share":
+        # Variant: the unsafe share of the shell. With the count, the shell holds 26 cells at 50 m
+        # but 602 at 10 m, so μ·R(t) grows 23-fold with resolution and outweighs Eq. 10 entirely.
+        inner = [max(n - 2, 0) for n in n_s]
+        shell /= float(np.prod(n_s) - np.prod(inner))
     c_h, c_v = transport_rates(scenario)
     return PlanningModel(scenario, field, admissible, risk, shell, n_s, c_h, c_v)

@@ -1,0 +1,185 @@
+"""The paper's preliminary strategy (Sec. 5.2.1, Figs. 11-13) and the decoder the GA variants share.
+
+Preliminary strategy
+--------------------
+Flights are taken in the conflict-resolution order f' = order of planned departure D (ties: flight
+index). Flight f is checked against every flight placed before it (Fig. 11): its departure starts
+at the earliest admissible time, max(D_f, arrival + ΔT of its aircraft's previous *operated* flight)
+(Eqs. 27-28), and while it conflicts with an already placed operated flight — dep_f lies in one of
+that pair's forbidden open intervals (``SchedulingProblem.conflict_arrays``, the 3×3×3 zone of
+Fig. 13) — it is delayed past the interval's end (Fig. 12). Delays are whole multiples of
+ΔT_a (``step_s``, Table B.3: 10 s), so a delay is rounded *up* to the step; with ``exact_gaps``
+the flight goes exactly to the gap's end instead. When the delay needed exceeds the flight's
+threshold, min(Δd_f, T_f − A_f) (Eqs. 26, 29), the flight is cancelled; a cancelled outbound
+cancels its return (MODEL_NOTES: the aircraft never left). The result is feasible by construction.
+
+Decoder (shared with :mod:`uamopt.solvers.genetic`)
+---------------------------------------------------
+:class:`Decoder` runs the same strategy for a whole population at once (numpy over individuals,
+a Python loop over the n flights). Each individual is an integer chromosome (Fig. 14), one gene per
+flight: gene k ≥ 0 asks for a delay of at least k·ΔT_a, gene −1 (:data:`CANCEL`) cancels the
+flight. The all-zero chromosome decodes to the preliminary strategy's schedule.
+
+Options (``[options]`` of a profile): ``step_s`` (ΔT_a, s, default 10.0) and ``exact_gaps``
+(default false: the paper's ΔT_a steps).
+
+>>> # schedule = solve(problem, SolverProfile(solver="greedy"))
+"""
+
+from __future__ import annotations
+
+import time
+import weakref
+from dataclasses import dataclass
+
+import numpy as np
+
+from uamopt.errors import UamoptError
+from uamopt.schedule.model import Schedule, SchedulingProblem, make_schedule
+
+CANCEL = -1  # gene value meaning "cancel this flight" (Fig. 14 extended with a cancel allele)
+DEFAULT_STEP_S = 10.0  # ΔT_a, s (Table B.3)
+EPS_S = 1e-7  # times closer than this are equal (well inside the verifier's 1e-6 s), s
+
+
+@dataclass(frozen=True, eq=False)
+class Decoder:
+    """The conflict-resolution order and, per flight, the forbidden windows against earlier flights.
+
+    For the flight at position i of ``order``, rows ``ptr[i]:ptr[i+1]`` say: its delay d must avoid
+    the open interval (dep_e + ``lo``, dep_e + ``hi``) for each placed, operated ``partner`` e,
+    with lo and hi already relative to its planned departure (intervals of δ = dep_q − dep_p
+    turned into intervals of d).
+    """
+
+    order: np.ndarray  # flight indices in conflict-resolution order f'
+    ptr: np.ndarray  # (n + 1,) rows of each position
+    partner: np.ndarray  # (K,) earlier flight of each row
+    lo: np.ndarray  # (K,) s, relative to the flight's planned departure
+    hi: np.ndarray  # (K,) s
+
+    @classmethod
+    def from_problem(cls, problem: SchedulingProblem, order: np.ndarray | None = None) -> Decoder:
+        n = problem.n_flights
+        if order is None:
+            order = np.lexsort((np.arange(n), problem.planned_departure_s))
+        order = np.asarray(order, dtype=np.int64)
+        pos = np.empty(n, dtype=np.int64)
+        pos[order] = np.arange(n)
+        pairs, ptr, intervals = problem.conflict_arrays
+        row_pair = np.repeat(np.arange(len(pairs)), np.diff(ptr))
+        p, q = pairs[row_pair, 0], pairs[row_pair, 1]
+        lo, hi = intervals[:, 0], intervals[:, 1]
+        dep0 = problem.planned_departure_s
+        q_later = pos[q] > pos[p]
+        # q placed after p: dep_q ∈ (dep_p + lo, dep_p + hi); p after q: dep_p ∈ (dep_q − hi, dep_q − lo)
+        later = np.where(q_later, q, p)
+        partner = np.where(q_later, p, q)
+        rel_lo = np.where(q_later, lo, -hi) - dep0[later]
+        rel_hi = np.where(q_later, hi, -lo) - dep0[later]
+        rows = np.argsort(pos[later], kind="stable")
+        counts = np.bincount(pos[later], minlength=n)
+        return cls(order=order, ptr=np.concatenate([[0], np.cumsum(counts)]).astype(np.int64),
+                   partner=partner[rows], lo=rel_lo[rows], hi=rel_hi[rows])
+
+    def decode(self, problem: SchedulingProblem, genes: np.ndarray, step_s: float = DEFAULT_STEP_S,
+               exact_gaps: bool = False) -> tuple[np.ndarray, np.ndarray]:
+        """Feasible schedules of a population of chromosomes (the preliminary strategy, Sec. 5.2.1).
+
+        Parameters
+        ----------
+        genes : int array (P, n) or (n,)
+            Per flight (in flight-index order) the wished delay in units of ``step_s``, or
+            :data:`CANCEL`.
+        step_s : float
+            ΔT_a, s: delays are multiples of it (unless ``exact_gaps``).
+        exact_gaps : bool
+            Push a conflicting flight exactly to the end of the forbidden gap, not to the next step.
+
+        Returns
+        -------
+        operated : bool array (P, n)
+        delay_s : float array (P, n), s; 0 where cancelled. Each row passes ``violations``.
+        """
+        genes = np.atleast_2d(np.asarray(genes, dtype=np.int64))
+        size, n = genes.shape
+        dep0, upper = problem.planned_departure_s, problem.delay_upper_s
+        free_after = problem.flight_time_s + problem.turnaround_after_s  # dep_e + this ≤ next dep (Eq. 27)
+        aircraft, requires = problem.flights.aircraft_index, problem.requires
+        operated = np.zeros((size, n), dtype=bool)
+        dep = np.zeros((size, n))
+        delay = np.zeros((size, n))
+        ready = np.full((size, problem.flights.n_aircraft), -np.inf)  # earliest next departure per aircraft
+
+        def snap(d: np.ndarray) -> np.ndarray:  # round a delay up to the ΔT_a grid
+            return d if exact_gaps else np.ceil(d / step_s - EPS_S / step_s) * step_s
+
+        for i, f in enumerate(self.order):
+            g, cap = aircraft[f], upper[f] + EPS_S
+            want = genes[:, f]
+            on = want != CANCEL
+            if requires[f] >= 0:
+                on &= operated[:, requires[f]]  # a cancelled outbound cancels its return
+            d = snap(np.maximum(np.maximum(want, 0) * step_s, ready[:, g] - dep0[f]))
+            a, b = self.ptr[i], self.ptr[i + 1]
+            if b > a:
+                others = self.partner[a:b]
+                live = operated[:, others]  # only operated partners constrain
+                lo = dep[:, others] + self.lo[a:b]
+                hi = dep[:, others] + self.hi[a:b]
+                for _ in range(b - a + 1):  # each pass leaves at least one interval behind for good
+                    inside = live & (lo + EPS_S < d[:, None]) & (d[:, None] < hi - EPS_S)
+                    inside &= (on & (d <= cap))[:, None]
+                    hit = inside.any(axis=1)
+                    if not hit.any():
+                        break
+                    d = np.where(hit, snap(np.where(inside, hi, -np.inf).max(axis=1)), d)
+            on &= d <= cap
+            operated[:, f] = on
+            delay[:, f] = np.where(on, np.minimum(d, upper[f]), 0.0)
+            dep[:, f] = dep0[f] + delay[:, f]
+            ready[on, g] = dep[on, f] + free_after[f]
+        return operated, delay
+
+
+_DECODERS: "weakref.WeakKeyDictionary[SchedulingProblem, Decoder]" = weakref.WeakKeyDictionary()
+
+
+def decoder_for(problem: SchedulingProblem) -> Decoder:
+    """The problem's :class:`Decoder` in planned-departure order, built once per problem."""
+    decoder = _DECODERS.get(problem)
+    if decoder is None:
+        decoder = _DECODERS[problem] = Decoder.from_problem(problem)
+    return decoder
+
+
+def decoder_options(options: dict, solver: str) -> tuple[float, bool]:
+    """``step_s`` and ``exact_gaps`` of a profile's options, validated (ΔT_a > 0)."""
+    step_s = float(options.get("step_s", DEFAULT_STEP_S))
+    if not step_s > 0:
+        raise UamoptError(f"step_s must be positive, got {step_s}", f"solver {solver}", "give ΔT_a in seconds, e.g. 10")
+    return step_s, bool(options.get("exact_gaps", False))
+
+
+def check_options(options: dict, known: set[str], solver: str) -> None:
+    """Raise on an option the solver does not know (scikit-learn style: validate at the boundary)."""
+    unknown = sorted(set(options) - known)
+    if unknown:
+        raise UamoptError(f"unknown option '{unknown[0]}'", f"solver {solver}", f"valid options are {', '.join(sorted(known))}")
+
+
+def greedy_decisions(problem: SchedulingProblem, step_s: float = DEFAULT_STEP_S, exact_gaps: bool = False
+                     ) -> tuple[np.ndarray, np.ndarray]:
+    """Operated flags and delays (s) of the preliminary strategy (Sec. 5.2.1)."""
+    operated, delay = decoder_for(problem).decode(problem, np.zeros(problem.n_flights, dtype=np.int64), step_s, exact_gaps)
+    return operated[0], delay[0]
+
+
+def solve(problem: SchedulingProblem, profile) -> Schedule:
+    """The preliminary strategy as a solver: status "feasible", no bound."""
+    check_options(profile.options, {"step_s", "exact_gaps"}, "greedy")
+    step_s, exact = decoder_options(profile.options, "greedy")
+    start = time.perf_counter()
+    operated, delay = greedy_decisions(problem, step_s, exact)
+    return make_schedule(problem, "greedy", "feasible", operated, delay, solve_seconds=time.perf_counter() - start,
+                         seed=profile.seed, extras={"step_s": step_s, "exact_gaps": exact})
