@@ -179,3 +179,18 @@ def test_network_directions_on_separate_layers(model, tmp_path):
     path.write_text(json.dumps(doc))
     loaded = load_network(path)
     assert set(loaded) == set(network) and loaded["V1-V4"].shape[1] == 3
+
+
+def test_share_variant_gives_table2_shape(root):
+    """With R(t) as the unsafe share of the buffer's shell, the initial, equivalent and optimal
+    tracks carry less risk than the shortest and cost more (the shape of the paper's Table 2)."""
+    s = load_scenario(root / "models" / "paper_case.toml", ["tracks.buffer_measure=share"])
+    m = planning_model(s, compute_risk(s).field)
+    assert m.shell_count.max() <= 1.0
+    st_ = plan_track(m, P_O, P_D).stages
+    for name in ("initial", "equivalent", "optimal"):
+        assert st_[name].risk_cost < st_["shortest"].risk_cost, name
+        assert st_[name].transport_cost > st_["shortest"].transport_cost, name
+    for name in ("equivalent", "optimal"):
+        assert st_[name].length_m < st_["initial"].length_m, name
+    assert st_["initial"].extra["search_cost"] == pytest.approx(st_["initial"].objective + st_["initial"].buffer_cost, rel=1e-9)
