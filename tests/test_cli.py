@@ -169,3 +169,44 @@ def test_out_is_a_file(tmp_path):
     target.write_text("keep me")
     assert_one_line_error(run("risk", PAPER, "--out", str(target)), "output path is a file")
     assert target.read_text() == "keep me"
+
+
+def test_schedule_verify_and_bench(tmp_path):
+    out = tmp_path / "sched"
+    proc = run("schedule", PAPER, "--solver", "highs", "--out", str(out))
+    assert proc.returncode == 0, proc.stderr
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "optimal" and summary["operated"] + summary["cancelled"] == 120
+    assert summary["avg_delay_s"] == pytest.approx(summary["total_delay_s"] / 20)
+    lines = (out / "schedule.csv").read_text().splitlines()
+    assert lines[0] == "flight,aircraft,route,operated,planned_departure_s,delay_s,departure_s,arrival_s"
+    assert len(lines) == 121
+    assert run("verify", str(out)).returncode == 0
+    # plant a conflict: run two flights on one route at the same time -> the verifier exits 1
+    rows = [l.split(",") for l in lines[1:]]
+    first = next(r for r in rows if r[3] == "1")
+    twin = next(r for r in rows if r[2] == first[2] and r[0] != first[0] and r[1] != first[1])
+    twin[3], twin[5], twin[6] = "1", "0.0", first[6]
+    twin[4] = str(float(first[6]))
+    twin[7] = str(float(first[7]))
+    (out / "schedule.csv").write_text("\n".join([lines[0]] + [",".join(r) for r in rows]) + "\n")
+    bad = run("verify", str(out))
+    assert bad.returncode == 1 and bad.stdout.strip()
+    bench = tmp_path / "bench"
+    proc = run("bench", PAPER, "--solver", "greedy", "cpsat", "--out", str(bench))
+    assert proc.returncode == 0, proc.stderr
+    csv_rows = (bench / "bench.csv").read_text().splitlines()
+    assert len(csv_rows) == 3 and csv_rows[1].endswith("yes") and csv_rows[2].endswith("yes")
+    assert (bench / "bench.md").exists()
+
+
+def test_schedule_bad_input(tmp_path):
+    flights = tmp_path / "flights.json"
+    flights.write_text(json.dumps({"cell": [50, 50, 30], "conflict_radius": 1, "flights": [
+        {"id": "f1", "aircraft": "A", "route": "V9-V1", "origin": "V9", "destination": "V1", "speed_mps": 25,
+         "planned_departure_s": 0, "max_delay_s": 100}]}))
+    out = tmp_path / "o"
+    assert_one_line_error(run("schedule", PAPER, "--solver", "greedy", "--flights", str(flights), "--out", str(out)),
+                          "unknown route")
+    assert_one_line_error(run("schedule", PAPER, "--solver", "nosuch", "--out", str(out)), "solver profile not found")
+    assert not out.exists()

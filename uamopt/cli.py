@@ -173,6 +173,38 @@ def _plan_at(scenario, side: float, extent) -> tuple:
     return fine, model, plan, time.perf_counter() - started
 
 
+REPRODUCE_SOLVERS = ("greedy", "ga", "soa", "highs", "cpsat")
+
+
+def _reproduce_schedules(scenario, model, network_doc: dict, stage: Path, bar) -> list[str]:
+    """Table 3 / Fig. 19: every solver profile on the paper-case plan over the planned network."""
+    from uamopt.plot_schedule import plot_delay_comparison, plot_gantt
+    from uamopt.report import table3_section
+    from uamopt.schedule import build_problem, write_schedule
+    from uamopt.schedule.verify import verify_dir
+    from uamopt.solvers import load_profile, solve
+
+    network = {k: np.asarray(v["waypoints"]) for k, v in network_doc["routes"].items()}
+    flights = _initial_plan(scenario, network, scenario.schedule.plan_seed)
+    sections = []
+    for objective in (scenario.schedule.objective, "lexicographic" if scenario.schedule.objective == "weighted" else "weighted"):
+        problem = build_problem(flights, scenario, objective=objective)
+        schedules, verified = {}, {}
+        for name in REPRODUCE_SOLVERS:
+            bar.set_description(f"schedule ({objective}): {name}")
+            schedule = solve(problem, load_profile(name))
+            folder = stage / "schedules" / objective / name
+            write_schedule(folder, problem, schedule)
+            schedules[name], verified[name] = schedule, not verify_dir(folder)
+            bar.update(1)
+        suffix = "" if objective == scenario.schedule.objective else f"_{objective}"
+        best = min((s for s in schedules.values() if s.objective is not None), key=lambda s: s.objective)
+        plot_gantt(problem, best, stage / f"gantt{suffix}.png")
+        plot_delay_comparison(problem, schedules, stage / f"delays{suffix}.png")
+        sections.append(table3_section(problem, schedules, verified, suffix=suffix))
+    return sections
+
+
 def cmd_reproduce(args) -> int:
     from uamopt.outputs import check_out_dir, staged_output, write_json
     from uamopt.planning import planning_model
@@ -185,7 +217,7 @@ def cmd_reproduce(args) -> int:
     check_out_dir(args.out)
     t2 = scenario.tracks.table2_cell_m
     sides = [t2] + [c for c in scenario.tracks.table4_cells if c != t2]
-    with _progress(4 + 20 + len(sides), "reproduce") as bar, staged_output(args.out) as stage:
+    with _progress(4 + 20 + len(sides) + 2 * len(REPRODUCE_SOLVERS), "reproduce") as bar, staged_output(args.out) as stage:
         run, summary = _risk_stage(scenario, stage, bar)
         model = planning_model(scenario, run.field)
         network = _network_stage(scenario, model, stage, bar)
@@ -209,14 +241,24 @@ def cmd_reproduce(args) -> int:
         fronts = {flag: weight_sweep(model, scenario.tracks.origin, scenario.tracks.destination, 9, buffer=flag)
                   for flag in (False, True)}
         plot_pareto(fronts[False], stage / "pareto.png", title=f"{scenario.name}: Eq. 10 trade-off (μ = 0)")
+        sched_sections = _reproduce_schedules(scenario, model, network["doc"], stage, bar)
         sections = [risk_section(scenario, summary), table2_section(fine, fine_model, tracks),
                     table2_section(v_scenario, v_model, v_tracks, figure=False,
                                    title=f"Table 2 analogue with the variant tracks.buffer_measure = \"{other}\""),
                     table4_section(scenario, table4), pareto_section(scenario, model, fronts),
-                    network_section(scenario, network["doc"])]
+                    network_section(scenario, network["doc"])] + sched_sections
         write_report(stage / "report.md", scenario, sections)
     print(f"report: {Path(args.out) / 'report.md'}")
     return 0
+
+
+def _initial_plan(scenario, network, seed: int):
+    """The generated initial flight plan with the scenario's [schedule] knobs."""
+    from uamopt.solvers.calibration import paper_case_plan
+
+    sc = scenario.schedule
+    return paper_case_plan(scenario, network, seed, max_delay_scale=sc.max_delay_scale,
+                           first_departure_window_s=sc.first_departure_window_s, departure_step_s=sc.departure_step_s)
 
 
 def _scheduling_problem(scenario, args, bar):
@@ -224,7 +266,7 @@ def _scheduling_problem(scenario, args, bar):
     from uamopt.grid import build_grid
     from uamopt.planning import planning_model
     from uamopt.planning.network import load_network, network_document, plan_network
-    from uamopt.schedule import build_problem, generate_plan, load_flights
+    from uamopt.schedule import build_problem, load_flights
     from uamopt.stages import compute_risk
 
     grid = build_grid(scenario)
@@ -241,10 +283,7 @@ def _scheduling_problem(scenario, args, bar):
     if args.flights:
         flights = load_flights(args.flights, scenario, grid, network)
     else:
-        sc = scenario.schedule
-        seed = sc.plan_seed if args.seed is None else args.seed
-        flights = generate_plan(scenario, network, seed, service_s=sc.service_s,
-                                first_departure_window_s=sc.first_departure_window_s)
+        flights = _initial_plan(scenario, network, scenario.schedule.plan_seed if args.seed is None else args.seed)
     bar.set_description("conflicts")
     problem = build_problem(flights, scenario, objective=scenario.schedule.objective)
     bar.update(1)

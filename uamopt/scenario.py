@@ -224,6 +224,10 @@ class ScheduleConfig(_Section):
         600.0, description="first planned departures of the aircraft are drawn in [T_s, T_s + window], s"
     )
     plan_seed: int = Field(0, description="seed of the initial flight plan generator")
+    departure_step_s: PositiveFloat = Field(1.0, description="grid of the generated first departures, s")
+    max_delay_scale: Annotated[float, Field(gt=0, le=1)] = Field(
+        1.0, description="Δd as a share of Eq. 29's bound round(L/v_g) + ΔT (Eq. 29 allows any Δd up to it)"
+    )
     objective: Literal["weighted", "lexicographic"] = Field(
         "weighted", description="Eq. 20 (ω6 T_d − ω7 S), or most flights first then least delay"
     )

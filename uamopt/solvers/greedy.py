@@ -21,9 +21,9 @@ flight: gene k ≥ 0 asks for a delay of at least k·ΔT_a, gene −1 (:data:`CA
 flight. The all-zero chromosome decodes to the preliminary strategy's schedule.
 
 Options (``[options]`` of a profile): ``step_s`` (ΔT_a, s, default 10.0) and ``exact_gaps``
-(default false: the paper's ΔT_a steps).
+(default false: the paper's ΔT_a steps). Usage::
 
->>> # schedule = solve(problem, SolverProfile(solver="greedy"))
+    schedule = uamopt.solvers.solve(problem, SolverProfile("greedy", options={"step_s": 10.0}))
 """
 
 from __future__ import annotations
@@ -142,7 +142,7 @@ class Decoder:
         return operated, delay
 
 
-_DECODERS: "weakref.WeakKeyDictionary[SchedulingProblem, Decoder]" = weakref.WeakKeyDictionary()
+_DECODERS: weakref.WeakKeyDictionary[SchedulingProblem, Decoder] = weakref.WeakKeyDictionary()
 
 
 def decoder_for(problem: SchedulingProblem) -> Decoder:

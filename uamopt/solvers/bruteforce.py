@@ -1,0 +1,141 @@
+"""An exact reference for *tiny* instances (≤ ``MAX_FLIGHTS`` flights): a test oracle, not a solver.
+
+It shares nothing with ``milp.py`` or ``cpsat.py`` beyond the model data of
+:class:`SchedulingProblem` (Sec. 4.3) and enumerates instead of modelling:
+
+1. every operate/cancel vector c ∈ {0, 1}ⁿ that keeps the precedence (a return needs its
+   outbound), most operated flights first;
+2. for a fixed c the objective (Eqs. 20-22) only needs the least total delay Σ d_f. Each pair
+   of operated flights with forbidden open intervals of δ = dep_q − dep_p must put δ in one of
+   the closed gaps between them (within δ's reachable range); for a fixed choice of gaps every
+   constraint — the gap, the turnaround of Eqs. 27-28 between every two operated flights of an
+   aircraft, 0 ≤ d_f ≤ U_f (Eqs. 26, 29) — is linear, so the least Σ d is an LP, solved by
+   ``scipy.optimize.linprog`` (HiGHS). The gap choices are enumerated depth first; a partial
+   choice is an LP relaxation of its completions, so a branch is cut when its LP is infeasible
+   or already no better than the best completion found (exact pruning).
+3. c vectors are abandoned once −ω7·S (the objective with zero delay) cannot beat the best.
+
+Register nothing: call ``solve(problem, profile)`` (same signature as the solvers) from tests.
+"""
+
+from __future__ import annotations
+
+import itertools
+import time
+
+import numpy as np
+from scipy.optimize import linprog
+
+from uamopt.errors import UamoptError
+from uamopt.schedule.model import Schedule, SchedulingProblem, make_schedule
+
+MAX_FLIGHTS = 10  # 2¹⁰ operate vectors; beyond that use ``highs``
+LP_TOL = 1e-7  # the LP's own accuracy on Σ d, s
+
+
+def _objective(problem: SchedulingProblem, operated: int, total_delay_s: float) -> float:
+    """Eqs. 20-22 or model.py's lexicographic scalar, written out again on purpose."""
+    if problem.objective_kind == "lexicographic":
+        return -operated + total_delay_s / (float(np.sum(problem.delay_upper_s)) + 1.0)
+    w6, w7 = problem.weights
+    return w6 * total_delay_s / problem.aircraft_count - w7 * operated
+
+
+def _gap_choices(problem: SchedulingProblem) -> list[tuple[int, int, list[tuple[float, float]]]]:
+    """Per conflict pair: the closed gaps of δ between its forbidden open intervals, within reach."""
+    out = []
+    dep, upper = problem.planned_departure_s, problem.delay_upper_s
+    for conflict in problem.conflicts:
+        p, q = conflict.p, conflict.q
+        low, high = dep[q] - dep[p] - upper[p], dep[q] - dep[p] + upper[q]
+        edges = [low] + [v for row in np.asarray(conflict.intervals).tolist() for v in row] + [high]
+        # gaps are [edges[2i], edges[2i+1]]: from the reach's start or an interval's end to the next start
+        gaps = [(max(a, low), min(b, high)) for a, b in zip(edges[0::2], edges[1::2])]
+        out.append((p, q, [(a, b) for a, b in gaps if a <= b and a <= high and b >= low]))
+    return out
+
+
+def _lp(problem: SchedulingProblem, flown: list[int], rows: list[tuple[int, int, float]]):
+    """min Σ d over the operated flights s.t. d_i − d_j ≤ b for (i, j, b) in rows, 0 ≤ d ≤ U."""
+    col = {f: k for k, f in enumerate(flown)}
+    a_ub = np.zeros((len(rows), len(flown)))
+    b_ub = np.zeros(len(rows))
+    for r, (i, j, b) in enumerate(rows):
+        a_ub[r, col[i]] += 1.0
+        a_ub[r, col[j]] -= 1.0
+        b_ub[r] = b
+    res = linprog(np.ones(len(flown)), A_ub=a_ub if rows else None, b_ub=b_ub if rows else None,
+                  bounds=[(0.0, float(problem.delay_upper_s[f])) for f in flown], method="highs")
+    if res.status == 2:
+        return None
+    if res.status != 0:
+        raise UamoptError(f"linprog failed: {res.message}", "bruteforce", "this is a test oracle; report it")
+    return float(res.fun), res.x
+
+
+def least_delay(problem: SchedulingProblem, operated: np.ndarray) -> tuple[float, np.ndarray] | None:
+    """The least total delay and its delays for the operate vector ``operated``, or None if none is feasible."""
+    dep, time_s, gap = problem.planned_departure_s, problem.flight_time_s, problem.turnaround_after_s
+    flown = [int(f) for f in np.flatnonzero(operated)]
+    if not flown:
+        return 0.0, np.zeros(problem.n_flights)
+    fixed = []
+    for chain in problem.chains:  # dep_f ≥ dep_e + T_e + ΔT_e  ⇔  d_e − d_f ≤ D_f − D_e − T_e − ΔT_e
+        mine = [int(f) for f in chain if operated[f]]
+        fixed += [(e, f, dep[f] - dep[e] - time_s[e] - gap[e]) for i, e in enumerate(mine) for f in mine[i + 1:]]
+    branching = []
+    for p, q, gaps in _gap_choices(problem):
+        if not (operated[p] and operated[q]):
+            continue
+        if not gaps:
+            return None
+        # δ ∈ [a, b]  ⇔  d_p − d_q ≤ ΔD − a  and  d_q − d_p ≤ b − ΔD
+        shift = dep[q] - dep[p]
+        branching.append([[(p, q, shift - a), (q, p, b - shift)] for a, b in gaps])
+    branching.sort(key=len)
+    best: list = [np.inf, None]
+
+    def dfs(depth: int, rows: list) -> None:
+        found = _lp(problem, flown, rows)
+        if found is None or found[0] >= best[0] - LP_TOL:
+            return
+        if depth == len(branching):
+            best[:] = list(found)
+            return
+        for choice in branching[depth]:
+            dfs(depth + 1, rows + choice)
+
+    dfs(0, fixed)
+    if best[1] is None:
+        return None
+    delay = np.zeros(problem.n_flights)
+    delay[flown] = np.clip(best[1], 0.0, problem.delay_upper_s[flown])
+    return float(delay.sum()), delay
+
+
+def solve(problem: SchedulingProblem, profile=None) -> Schedule:
+    """The exact optimum by enumeration (see the module docstring); ``profile`` is ignored.
+
+    Raises
+    ------
+    UamoptError
+        More than ``MAX_FLIGHTS`` flights.
+    """
+    n = problem.n_flights
+    if n > MAX_FLIGHTS:
+        raise UamoptError(f"{n} flights is too many for the brute force", "bruteforce", f"use at most {MAX_FLIGHTS} or the highs solver")
+    start = time.perf_counter()
+    requires = problem.requires
+    vectors = [np.array(c, dtype=bool) for c in itertools.product((True, False), repeat=n)]
+    vectors = [c for c in vectors if all(requires[f] < 0 or c[requires[f]] for f in np.flatnonzero(c))]
+    vectors.sort(key=lambda c: -int(c.sum()))  # stable: ties keep the product order
+    best_value, best = np.inf, None
+    for c in vectors:
+        if _objective(problem, int(c.sum()), 0.0) >= best_value - 1e-12:
+            break  # every later vector operates no more flights
+        found = least_delay(problem, c)
+        if found is not None and _objective(problem, int(c.sum()), found[0]) < best_value:
+            best_value, best = _objective(problem, int(c.sum()), found[0]), (c, found[1])
+    assert best is not None  # cancelling every flight is always feasible
+    return make_schedule(problem, "bruteforce", "optimal", best[0], best[1], bound=best_value,
+                         solve_seconds=time.perf_counter() - start, extras={"vectors": len(vectors)})

@@ -1,0 +1,197 @@
+"""Solver ``cpsat``: the scheduling model of Sec. 4.3 (Eqs. 20-31) in OR-Tools CP-SAT.
+
+CP-SAT works on integers, so time is counted in units of u = ``time_unit_s`` (default 0.01 s):
+the delay of flight f is d_f = u·k_f with k_f ∈ {0, …, ⌊U_f/u⌋} (Eqs. 26, 29). Planned
+departures stay real; every constraint is written on k with its real constant rounded so that
+the integer set is *inside* the real one:
+
+- cancelled ⇒ k_f = 0; precedence c_f ⇒ c_{requires[f]} (an implication);
+- turnaround (Eqs. 27-28), e before f of one aircraft, enforced only if c_e ∧ c_f:
+  k_f − k_e ≥ ⌈(D_e + T_e + ΔT_e − D_f)/u⌉;
+- conflicts (Eq. 24), enforced only if c_p ∧ c_q (an enforcement list: the b ⇔ both of the
+  paper's linearisation without an extra variable): k_q − k_p avoids every integer z of the
+  open interval ((lo − ΔD)/u, (hi − ΔD)/u), ΔD = D_q − D_p, i.e. z ∉ [⌊x_lo⌋ + 1, ⌈x_hi⌉ − 1];
+  with no admissible z left, ¬c_p ∨ ¬c_q.
+
+Every rounding is outward, so any CP-SAT solution is feasible in the real model (up to
+``ROUND_S`` = 10⁻⁹ s of float round-off, far below the model's ``TIME_TOL_S``) and its objective is
+≥ the real optimum. When every time of the data is a multiple of u (planned departures, flight and
+cell-crossing times, gaps, delay bounds), the rounding is exact and, the constraints being
+difference constraints (totally unimodular for fixed choices), CP-SAT's optimum *is* the real one.
+Otherwise a feasible window narrower than u may hold no integer point, so the discretised optimum
+can be worse; the paper-case test bounds the difference empirically.
+
+Objective, made integral: ``weighted`` ω6·u·Σk/G − ω7·Σc times L, the least common denominator of
+ω6·u/G and ω7 read as decimals (``Fraction(repr(w))``); if L would overflow int64 arithmetic, the
+two coefficients are scaled to 10⁹ and rounded (``extras["objective_scale"]`` says which).
+``lexicographic``: Σk − (Σ⌊U/u⌋ + 1)·Σc, the same order as model.py's scalar. The returned
+objective is ``make_schedule``'s evaluation of d = u·k on the real model; the returned bound is
+CP-SAT's bound mapped back, a bound of the *discretised* model (``extras["bound_of"]``).
+
+Profile options: ``time_unit_s`` (default 0.01); ``threads`` → ``num_workers``, ``seed`` →
+``random_seed``, ``time_limit_s`` → ``max_time_in_seconds``; other options are CP-SAT parameters
+(a list extends a repeated one). Defaults: ``linearization_level = 2`` with one thread,
+``subsolvers = ["max_lp", "default_lp"]`` with more (see ``solve_here``).
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from fractions import Fraction
+
+import numpy as np
+
+from uamopt.errors import UamoptError
+from uamopt.schedule.model import Schedule, SchedulingProblem, make_schedule
+from uamopt.solvers.milp import native_loaded, serve, solve_isolated
+
+ROUND_S = 1e-9  # float round-off accepted when rounding a real time to units, s
+INT_LIMIT = 2**62  # keep |objective| below this (CP-SAT uses int64)
+
+
+def _objective(problem: SchedulingProblem, unit_s: float, delay_max: np.ndarray) -> tuple[int, int, float, str]:
+    """Integer coefficients (per unit of delay, per operated flight), the divisor back to W, and how."""
+    total = int(delay_max.sum()) + 1
+    if problem.objective_kind == "lexicographic":
+        return 1, total, 1.0, "lexicographic"
+    w6, w7 = (Fraction(repr(float(w))) for w in problem.weights)
+    per_unit, per_flight = w6 * Fraction(repr(float(unit_s))) / problem.aircraft_count, w7
+    scale = math.lcm(per_unit.denominator, per_flight.denominator)
+    a, b = int(per_unit * scale), int(per_flight * scale)
+    if (abs(a) * total + abs(b) * len(delay_max)) < INT_LIMIT:
+        return a, b, float(scale), "exact"
+    top = max(float(per_unit), float(per_flight))
+    return round(float(per_unit) / top * 1e9), round(float(per_flight) / top * 1e9), 1e9 / top, "approximate"
+
+
+def build_cpsat(problem: SchedulingProblem, unit_s: float = 0.01):
+    """The CP-SAT model; returns (model, operate vars, delay vars in units, per-unit coef, per-flight coef, divisor, how)."""
+    from ortools.sat.python import cp_model  # imported on use: see ``solve``
+    from ortools.util.python.sorted_interval_list import Domain
+
+    eta = ROUND_S / unit_s
+    dep, time, gap = problem.planned_departure_s, problem.flight_time_s, problem.turnaround_after_s
+    delay_max = np.floor(problem.delay_upper_s / unit_s + eta).astype(np.int64)
+    model = cp_model.CpModel()
+    n = problem.n_flights
+    operate = [model.new_bool_var(f"c{f}") for f in range(n)]
+    delay = [model.new_int_var(0, int(delay_max[f]), f"k{f}") for f in range(n)]
+    for f in range(n):
+        model.add(delay[f] == 0).only_enforce_if(operate[f].Not())
+        if problem.requires[f] >= 0:
+            model.add_implication(operate[f], operate[int(problem.requires[f])])
+    for chain in problem.chains:
+        for i, e in enumerate(chain.tolist()):
+            for f in chain[i + 1:].tolist():
+                need = math.ceil((dep[e] + time[e] + gap[e] - dep[f]) / unit_s - eta)
+                if need > -delay_max[e]:
+                    model.add(delay[f] - delay[e] >= need).only_enforce_if([operate[e], operate[f]])
+    pairs, ptr, intervals = problem.conflict_arrays
+    for k, (p, q) in enumerate(pairs.tolist()):
+        shift = dep[q] - dep[p]
+        reach = Domain(-int(delay_max[p]), int(delay_max[q]))
+        forbidden = [[math.floor((lo - shift) / unit_s + eta) + 1, math.ceil((hi - shift) / unit_s - eta) - 1]
+                     for lo, hi in intervals[ptr[k]:ptr[k + 1]].tolist()]
+        forbidden = [iv for iv in forbidden if iv[0] <= iv[1]]
+        allowed = reach.intersection_with(Domain.from_intervals(forbidden).complement()) if forbidden else reach
+        if allowed.is_empty():
+            model.add_bool_or([operate[p].Not(), operate[q].Not()])
+        elif allowed.size() < reach.size():
+            model.add_linear_expression_in_domain(delay[q] - delay[p], allowed).only_enforce_if([operate[p], operate[q]])
+    per_unit, per_flight, divisor, how = _objective(problem, unit_s, delay_max)
+    model.minimize(per_unit * sum(delay) - per_flight * sum(operate))
+    return model, operate, delay, per_unit, per_flight, divisor, how
+
+
+def _bound(problem: SchedulingProblem, raw: float, per_flight: int, divisor: float, unit_s: float, how: str) -> float:
+    """CP-SAT's integer bound as a bound of W (weighted) or of model.py's lexicographic scalar."""
+    if how != "lexicographic":
+        return raw / divisor
+    # Σk − M·S ≥ B with 0 ≤ Σk < M gives −S ≥ s0 = ⌈(B − M + 1)/M⌉ and, at −S = s0, Σk ≥ B − M·s0
+    s0 = math.ceil((raw - per_flight + 1) / per_flight)
+    return s0 + unit_s * max(0.0, raw - per_flight * s0) / (float(np.sum(problem.delay_upper_s)) + 1.0)
+
+
+def solve(problem: SchedulingProblem, profile) -> Schedule:
+    """Solve the discretised model with CP-SAT; status optimal | feasible | time_limit | infeasible.
+
+    OR-Tools bundles its own libhighs.so.1, which may clash with highspy's: when OR-Tools fails
+    to import because highspy is loaded here, CP-SAT runs in a worker process
+    (``milp.solve_isolated``).
+    """
+    if not _importable_here():
+        if native_loaded("highspy"):
+            return solve_isolated(__name__, problem, profile)
+        raise UamoptError("OR-Tools is not installed", f"profile {profile.name or 'cpsat'}", "pip install ortools")
+    return solve_here(problem, profile)
+
+
+@functools.cache
+def _importable_here() -> bool:
+    """Whether OR-Tools imports in this process; asked once (a failed try costs ~0.1 s, and a
+    loaded highspy stays loaded)."""
+    try:
+        from ortools.sat.python import cp_model  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
+def solve_here(problem: SchedulingProblem, profile) -> Schedule:
+    """:func:`solve` in this process."""
+    from ortools.sat.python import cp_model
+
+    options = dict(profile.options)
+    unit_s = float(options.pop("time_unit_s", 0.01))
+    if not (math.isfinite(unit_s) and unit_s > 0):
+        raise UamoptError(f"time_unit_s must be a positive number of seconds, got {unit_s}",
+                          f"profile {profile.name or 'cpsat'}", "use e.g. 0.01")
+    model, operate, delay, _, per_flight, divisor, how = build_cpsat(problem, unit_s)
+    solver = cp_model.CpSolver()
+    solver.parameters.max_time_in_seconds = float(profile.time_limit_s)
+    solver.parameters.num_workers = int(profile.threads)
+    solver.parameters.random_seed = int(profile.seed)
+    # CP-SAT's default small portfolios carry no max-LP worker and cannot close the bound of the
+    # paper case in 60 s; with the big-M linear relaxation (level 2) they prove it in about 1 s
+    if int(profile.threads) == 1:
+        options.setdefault("linearization_level", 2)
+    else:
+        options.setdefault("subsolvers", ["max_lp", "default_lp"])
+    for key, value in options.items():
+        try:
+            if isinstance(value, list):
+                getattr(solver.parameters, key).extend(value)
+            else:
+                setattr(solver.parameters, key, value)
+        except (AttributeError, TypeError, ValueError) as exc:
+            raise UamoptError(f"unknown or invalid CP-SAT option '{key}': {exc}", f"profile {profile.name or 'cpsat'}",
+                              "see ortools/sat/sat_parameters.proto") from None
+    code = solver.solve(model)
+    seconds = float(solver.wall_time)
+    n = problem.n_flights
+    extras = {"termination": solver.status_name(code), "time_unit_s": unit_s, "objective_scale": how,
+              "bound_of": "time-discretised model", "branches": int(solver.num_branches)}
+    if code == cp_model.MODEL_INVALID:
+        raise UamoptError(f"CP-SAT rejected the model: {model.validate()}", f"profile {profile.name or 'cpsat'}",
+                          "report this as a bug")
+    if code == cp_model.INFEASIBLE:
+        return make_schedule(problem, "cpsat", "infeasible", np.zeros(n, bool), np.zeros(n), solve_seconds=seconds,
+                             seed=profile.seed, extras=extras)
+    if code == cp_model.UNKNOWN:  # no incumbent before the limit: cancelling every flight is always feasible
+        extras["incumbent"] = "none found: every flight cancelled"
+        return make_schedule(problem, "cpsat", "time_limit", np.zeros(n, bool), np.zeros(n), solve_seconds=seconds,
+                             seed=profile.seed, extras=extras)
+    operated = np.array([solver.boolean_value(v) for v in operate])
+    delay_s = np.array([solver.value(v) for v in delay], dtype=float) * unit_s
+    if code == cp_model.OPTIMAL:
+        status = "optimal"
+    else:
+        status = "time_limit" if seconds >= 0.99 * profile.time_limit_s else "feasible"
+    bound = _bound(problem, solver.best_objective_bound, per_flight, divisor, unit_s, how)
+    return make_schedule(problem, "cpsat", status, operated, delay_s, bound=bound, solve_seconds=seconds,
+                         seed=profile.seed, extras=extras)
+
+
+if __name__ == "__main__":
+    serve(solve_here)

@@ -1,0 +1,316 @@
+"""Solver ``highs``: the exact MILP of Sec. 4.3 (Eqs. 20-31) in Pyomo, solved by HiGHS.
+
+The model (PyPSA style: ``build_model`` calls one ``define_*`` per constraint family), on the
+data of a :class:`SchedulingProblem`:
+
+Variables
+    c_f ∈ {0, 1}  (``operate``), operated or cancelled;
+    d_f ∈ [0, U_f] (``delay``, s), U_f = ``delay_upper_s[f]`` = min(Δd_f, T_f − A_f) (Eqs. 26, 29);
+    d_f ≤ U_f c_f, so a cancelled flight's delay is 0 and Σ_f d_f = Σ_f c_f d_f exactly (Eq. 21
+    is bilinear otherwise).
+(a) precedence   c_f ≤ c_{requires[f]}: a return needs its outbound.
+(b) turnaround   (Eqs. 27-28), every ordered pair e before f of one aircraft:
+    dep_f − dep_e ≥ T_e + ΔT_e when c_e = c_f = 1. With A = D_e + T_e + ΔT_e − D_f this is
+    d_f − d_e ≥ A − M_f (1 − c_f) − M_e (1 − c_e), M_f = (A + U_e)⁺, M_e = A⁺: the smallest M that
+    cut no point with a cancelled flight (its delay is 0); dropped when A + U_e ≤ 0 (never binds).
+(c) conflicts    (Eq. 24 via MODEL_NOTES' exact core): pair (p, q) must keep δ = dep_q − dep_p
+    out of its open intervals (lo_k, hi_k). Within δ's reachable range R = [D_q − D_p − U_p,
+    D_q − D_p + U_q] the admissible δ form closed gaps [g_j, h_j]; one binary y_j per gap,
+    Σ_j y_j ≥ c_p + c_q − 1, and y_j = 1 ⇒ g_j ≤ δ ≤ h_j with M = g_j − min R and max R − h_j (the
+    bound is dropped where M = 0). A pair with one gap needs no y (y = c_p + c_q − 1 is implied);
+    a pair with none cannot fly both: c_p + c_q ≤ 1.
+Objective (Eqs. 20-22) ``weighted``: W = ω6 Σ d_f / G − ω7 Σ c_f; ``lexicographic``:
+    −Σ c_f + Σ d_f / (Σ U_f + 1) (model.py).
+
+The returned delays are *polished*: for the MILP's choices (c and one gap per operated pair), the
+remaining constraints are difference constraints dep_j − dep_i ≥ w, whose least solution (it
+minimises Σ d) is a longest path from d = 0 (Bellman-Ford), computed exactly in floating point. This
+removes the big-M slack that integrality tolerances allow (y = 1 − 10⁻⁶ times M = 500 s is a
+0.5 ms conflict) and is never worse than the MILP's own delays.
+
+Profile options: ``mip_rel_gap`` (default 0.0); every other key goes to HiGHS unchanged
+(e.g. ``mip_feasibility_tolerance``). ``threads`` → HiGHS threads, ``seed`` → ``random_seed``.
+"""
+
+from __future__ import annotations
+
+import atexit
+import os
+import pickle
+import subprocess
+import sys
+from importlib.machinery import EXTENSION_SUFFIXES
+from pathlib import Path
+
+import numpy as np
+import pyomo.environ as pyo
+from pyomo.contrib.solver.common.factory import SolverFactory
+from pyomo.contrib.solver.common.results import SolutionStatus, TerminationCondition
+
+from uamopt.errors import UamoptError
+from uamopt.schedule.flights import TIME_TOL_S
+from uamopt.schedule.model import Schedule, SchedulingProblem, make_schedule
+
+SOLVER_NAME = "highs"  # Pyomo 6.10.x name of the HiGHS interface (newer upstream: "highs_persistent")
+
+
+def admissible_gaps(problem: SchedulingProblem) -> list[tuple[int, int, list[tuple[float, float]], float, float]]:
+    """Per conflicting pair: (p, q, closed gaps [(g, h), ...] of admissible δ, min R, max R), s."""
+    pairs, ptr, intervals = problem.conflict_arrays
+    dep, upper = problem.planned_departure_s, problem.delay_upper_s
+    out = []
+    for k, (p, q) in enumerate(pairs.tolist()):
+        r_lo, r_hi = dep[q] - dep[p] - upper[p], dep[q] - dep[p] + upper[q]
+        gaps, start = [], r_lo
+        for lo, hi in intervals[ptr[k]:ptr[k + 1]].tolist():  # sorted and disjoint (ConflictTable)
+            if min(lo, r_hi) >= start:
+                gaps.append((start, min(lo, r_hi)))
+            start = max(start, hi)
+        if start <= r_hi:
+            gaps.append((start, r_hi))
+        out.append((p, q, gaps, r_lo, r_hi))
+    return out
+
+
+def define_variables(m: pyo.ConcreteModel, problem: SchedulingProblem) -> None:
+    """c_f binary, 0 ≤ d_f ≤ U_f (Eqs. 26, 29) and d_f ≤ U_f c_f."""
+    upper = problem.delay_upper_s
+    m.flights = pyo.RangeSet(0, problem.n_flights - 1)
+    m.operate = pyo.Var(m.flights, within=pyo.Binary)
+    m.delay = pyo.Var(m.flights, bounds=lambda _, f: (0.0, float(upper[f])))
+    m.delay_if_operated = pyo.Constraint(m.flights, rule=lambda m, f: m.delay[f] <= float(upper[f]) * m.operate[f])
+
+
+def define_precedence(m: pyo.ConcreteModel, problem: SchedulingProblem) -> None:
+    """(a) c_f ≤ c_{requires[f]}: a cancelled outbound cancels its return."""
+    returns = [int(f) for f in np.flatnonzero(problem.requires >= 0)]
+    m.precedence = pyo.Constraint(returns, rule=lambda m, f: m.operate[f] <= m.operate[int(problem.requires[f])])
+
+
+def define_turnaround(m: pyo.ConcreteModel, problem: SchedulingProblem) -> None:
+    """(b) Eq. 27 for every ordered pair of one aircraft's flights, with tight big-M."""
+    dep, time, gap, upper = problem.planned_departure_s, problem.flight_time_s, problem.turnaround_after_s, problem.delay_upper_s
+    rows = {}
+    for chain in problem.chains:
+        for i, e in enumerate(chain.tolist()):
+            for f in chain[i + 1:].tolist():
+                need = dep[e] + time[e] + gap[e] - dep[f]  # A: d_f − d_e must reach it
+                if need + upper[e] > 0:
+                    rows[e, f] = (need, max(need + upper[e], 0.0), max(need, 0.0))
+    m.turnaround = pyo.Constraint(list(rows), rule=lambda m, e, f: m.delay[f] - m.delay[e] >= rows[e, f][0]
+                                  - rows[e, f][1] * (1 - m.operate[f]) - rows[e, f][2] * (1 - m.operate[e]))
+
+
+def define_conflicts(m: pyo.ConcreteModel, problem: SchedulingProblem) -> None:
+    """(c) the exact core: one binary per admissible gap of each conflicting pair (Eq. 24)."""
+    dep = problem.planned_departure_s
+    m.gaps_of = admissible_gaps(problem)
+    never, single, multi = [], [], []
+    for k, (_, _, gaps, _, _) in enumerate(m.gaps_of):
+        (never if not gaps else single if len(gaps) == 1 else multi).append(k)
+    m.not_both = pyo.Constraint(never, rule=lambda m, k: m.operate[m.gaps_of[k][0]] + m.operate[m.gaps_of[k][1]] <= 1)
+    m.gap_index = pyo.Set(initialize=[(k, j) for k in multi for j in range(len(m.gaps_of[k][2]))], dimen=2)
+    m.in_gap = pyo.Var(m.gap_index, within=pyo.Binary)
+    m.pick_gap = pyo.Constraint(multi, rule=lambda m, k: sum(m.in_gap[k, j] for j in range(len(m.gaps_of[k][2])))
+                                >= m.operate[m.gaps_of[k][0]] + m.operate[m.gaps_of[k][1]] - 1)
+    both = [(k, 0) for k in single] + list(m.gap_index)
+
+    def delta(m, k):
+        p, q = m.gaps_of[k][:2]
+        return m.delay[q] - m.delay[p] + float(dep[q] - dep[p])
+
+    def slack(m, k, j):  # 1 − y_j, or 2 − c_p − c_q for a single gap
+        p, q, gaps = m.gaps_of[k][:3]
+        return 2 - m.operate[p] - m.operate[q] if len(gaps) == 1 else 1 - m.in_gap[k, j]
+
+    def above(m, k, j):
+        low, r_lo = m.gaps_of[k][2][j][0], m.gaps_of[k][3]
+        return pyo.Constraint.Skip if low <= r_lo else delta(m, k) >= low - (low - r_lo) * slack(m, k, j)
+
+    def below(m, k, j):
+        high, r_hi = m.gaps_of[k][2][j][1], m.gaps_of[k][4]
+        return pyo.Constraint.Skip if high >= r_hi else delta(m, k) <= high + (r_hi - high) * slack(m, k, j)
+
+    m.gap_above = pyo.Constraint(both, rule=above)
+    m.gap_below = pyo.Constraint(both, rule=below)
+
+
+def define_objective(m: pyo.ConcreteModel, problem: SchedulingProblem) -> None:
+    """Eqs. 20-22 (Σ d_f = Σ c_f d_f by d_f ≤ U_f c_f), or the lexicographic scalar."""
+    delay, flown = sum(m.delay[f] for f in m.flights), sum(m.operate[f] for f in m.flights)
+    if problem.objective_kind == "lexicographic":
+        m.objective = pyo.Objective(expr=-flown + delay / (float(np.sum(problem.delay_upper_s)) + 1.0))
+    else:
+        w6, w7 = problem.weights
+        m.objective = pyo.Objective(expr=w6 / problem.aircraft_count * delay - w7 * flown)
+
+
+def build_model(problem: SchedulingProblem) -> pyo.ConcreteModel:
+    """The Pyomo model of Eqs. 20-31 (see the module docstring), ready for any Pyomo solver."""
+    m = pyo.ConcreteModel(name="uam_schedule")
+    define_variables(m, problem)
+    define_precedence(m, problem)
+    define_turnaround(m, problem)
+    define_conflicts(m, problem)
+    define_objective(m, problem)
+    return m
+
+
+def least_delays(problem: SchedulingProblem, operated: np.ndarray, chosen: dict[int, tuple[float, float]]) -> np.ndarray | None:
+    """The least delays (minimal Σ d) of the operated flights for fixed gap choices, or None if none fit.
+
+    ``chosen`` maps a pair's row in ``admissible_gaps`` to its gap [g, h]. Bellman-Ford longest
+    path on dep_j ≥ dep_i + w from d = 0; at most n rounds, vectorised over the edges.
+    """
+    dep, time, gap, upper = problem.planned_departure_s, problem.flight_time_s, problem.turnaround_after_s, problem.delay_upper_s
+    edges = []  # (i, j, w): dep_j ≥ dep_i + w
+    for chain in problem.chains:
+        flown = [int(f) for f in chain if operated[f]]
+        edges += [(e, f, time[e] + gap[e]) for i, e in enumerate(flown) for f in flown[i + 1:]]
+    for k, (low, high) in chosen.items():
+        p, q = (int(v) for v in problem.conflict_arrays[0][k])
+        edges += [(p, q, low), (q, p, -high)]  # g ≤ dep_q − dep_p ≤ h
+    table = np.array(edges, dtype=float).reshape(-1, 3)
+    src, dst, weight = table[:, 0].astype(np.int64), table[:, 1].astype(np.int64), table[:, 2]
+    departure = dep.astype(float).copy()
+    for _ in range(problem.n_flights + 1):
+        pull = np.full_like(departure, -np.inf)
+        np.maximum.at(pull, dst, departure[src] + weight)
+        nxt = np.maximum(departure, pull)
+        if np.array_equal(nxt, departure):
+            delay = np.where(operated, departure - dep, 0.0)
+            return delay if np.all(delay <= upper + TIME_TOL_S / 10) else None
+        departure = nxt
+    return None  # a positive cycle: the choices admit no delays
+
+
+def _choices(m: pyo.ConcreteModel, operated: np.ndarray) -> dict[int, tuple[float, float]]:
+    """The gap each operated pair sits in, read from the MILP's binaries."""
+    chosen = {}
+    for k, (p, q, gaps, _, _) in enumerate(m.gaps_of):
+        if operated[p] and operated[q] and gaps:
+            j = 0 if len(gaps) == 1 else max(range(len(gaps)), key=lambda j: pyo.value(m.in_gap[k, j]))
+            chosen[k] = gaps[j]
+    return chosen
+
+
+def solve(problem: SchedulingProblem, profile) -> Schedule:
+    """Build and solve the MILP with HiGHS; a linopy-style status, never an exception on a limit.
+
+    Status: ``optimal`` (proved, within ``mip_rel_gap``), ``time_limit`` (limit hit; the incumbent
+    with HiGHS's bound, or all flights cancelled if HiGHS found none), ``infeasible``.
+    Runs in a worker process when highspy cannot load here because OR-Tools' copy of HiGHS
+    already is (see the end of this module).
+    """
+    solver = SolverFactory(SOLVER_NAME)
+    if (solver is None or not solver.available()) and native_loaded("ortools"):
+        return solve_isolated(__name__, problem, profile)
+    return solve_here(problem, profile)
+
+
+def solve_here(problem: SchedulingProblem, profile) -> Schedule:
+    """:func:`solve` in this process."""
+    options = dict(profile.options)
+    options.setdefault("mip_rel_gap", 0.0)
+    options.setdefault("random_seed", int(profile.seed))
+    m = build_model(problem)
+    solver = SolverFactory(SOLVER_NAME)
+    if solver is None or not solver.available():
+        raise UamoptError("HiGHS is not available to Pyomo", f"solver {profile.name or 'highs'}", "pip install highspy")
+    result = solver.solve(m, time_limit=float(profile.time_limit_s), threads=int(profile.threads), solver_options=options,
+                          load_solutions=False, raise_exception_on_nonoptimal_result=False)
+    tc, has_solution = result.termination_condition, result.solution_status in (SolutionStatus.optimal, SolutionStatus.feasible)
+    seconds = float(result.timing_info.wall_time or 0.0)
+    extras = {"termination": tc.name, "nodes": getattr(result.extra_info, "mip_node_count", None),
+              "highs_objective": result.incumbent_objective, "highs_seconds": result.timing_info.highs_time}
+    bound = result.objective_bound if result.objective_bound is not None and np.isfinite(result.objective_bound) else None
+    n = problem.n_flights
+    if tc in (TerminationCondition.provenInfeasible, TerminationCondition.infeasibleOrUnbounded):
+        return make_schedule(problem, "highs", "infeasible", np.zeros(n, bool), np.zeros(n), solve_seconds=seconds,
+                             seed=profile.seed, extras=extras)
+    if tc == TerminationCondition.convergenceCriteriaSatisfied and has_solution:
+        status = "optimal"
+    elif tc in (TerminationCondition.maxTimeLimit, TerminationCondition.iterationLimit, TerminationCondition.interrupted):
+        status = "time_limit"
+    else:
+        raise UamoptError(f"HiGHS stopped with {tc.name}", f"solver {profile.name or 'highs'}", "see the HiGHS log (tee=True)")
+    operated, delay = np.zeros(n, bool), np.zeros(n)
+    if has_solution:
+        result.solution_loader.load_vars()
+        operated = np.array([pyo.value(m.operate[f]) > 0.5 for f in range(n)])
+        polished = least_delays(problem, operated, _choices(m, operated))
+        extras["polished"] = polished is not None
+        raw = np.clip([pyo.value(m.delay[f]) for f in range(n)], 0.0, problem.delay_upper_s)
+        delay = polished if polished is not None else np.where(operated, raw, 0.0)
+    else:
+        extras["incumbent"] = "none found: every flight cancelled"
+    return make_schedule(problem, "highs", status, operated, delay, bound=bound, solve_seconds=seconds,
+                         seed=profile.seed, extras=extras)
+
+
+# --- Two HiGHS builds in one process -------------------------------------------------------
+# highspy 1.15.1 and ortools 9.15 each ship a libhighs.so.1 (ortools bundles HiGHS 1.12.0). The
+# dynamic loader keeps the first one loaded, and the other package then fails to import
+# ("undefined symbol"; a failed dlopen leaves nothing behind). So a solver whose package fails
+# to import while the other one is loaded runs in a worker: a child interpreter per solver
+# module, started on first need and reused, which reads pickled (problem, profile) and writes
+# back the pickled Schedule. With matching builds (highspy 1.12.0 beside ortools 9.15) both
+# import in one process and no worker is started.
+
+_WORKERS: dict[str, subprocess.Popen] = {}
+
+
+def native_loaded(package: str) -> bool:
+    """Whether a compiled extension of ``package`` (``"highspy"``, ``"ortools"``) is loaded here."""
+    return any(name.partition(".")[0] == package and str(getattr(mod, "__file__", "")).endswith(tuple(EXTENSION_SUFFIXES))
+               for name, mod in list(sys.modules.items()))
+
+
+def solve_isolated(module: str, problem: SchedulingProblem, profile) -> Schedule:
+    """``module.solve_here(problem, profile)`` in the module's worker process."""
+    worker = _WORKERS.get(module)
+    if worker is None or worker.poll() is not None:
+        root = str(Path(__file__).resolve().parents[2])
+        env = dict(os.environ, PYTHONPATH=os.pathsep.join(filter(None, [root, os.environ.get("PYTHONPATH")])))
+        worker = _WORKERS[module] = subprocess.Popen([sys.executable, "-m", module], stdin=subprocess.PIPE,
+                                                     stdout=subprocess.PIPE, env=env)
+    try:
+        pickle.dump((problem, profile), worker.stdin)
+        worker.stdin.flush()
+        answer = pickle.load(worker.stdout)
+    except (EOFError, BrokenPipeError, pickle.UnpicklingError) as exc:
+        worker.kill()
+        raise UamoptError(f"the {module} worker process died ({exc!r})", f"solver {profile.name or profile.solver}",
+                          "run the solver alone to see its error") from None
+    if isinstance(answer, BaseException):
+        raise answer
+    return answer
+
+
+@atexit.register
+def _stop_workers() -> None:
+    for worker in _WORKERS.values():
+        if worker.poll() is None:
+            worker.stdin.close()
+            worker.wait(timeout=10)
+
+
+def serve(solve_here) -> None:
+    """A worker's loop: (problem, profile) in on stdin, Schedule (or the exception) out on stdout."""
+    channel = os.fdopen(os.dup(1), "wb")
+    os.dup2(2, 1)  # solver logs printed to stdout must not corrupt the pickle stream
+    while True:
+        try:
+            problem, profile = pickle.load(sys.stdin.buffer)
+        except EOFError:
+            return
+        try:
+            answer = solve_here(problem, profile)
+        except Exception as exc:  # noqa: BLE001 - handed back to the parent, which raises it
+            answer = exc
+        pickle.dump(answer, channel)
+        channel.flush()
+
+
+if __name__ == "__main__":
+    serve(solve_here)
