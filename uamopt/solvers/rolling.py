@@ -1,0 +1,331 @@
+"""Solver ``rolling``: rolling-horizon decomposition of the scheduling model for large instances.
+
+Method
+------
+Flights are sorted by planned departure and the day is cut into windows of ``window_s`` seconds
+(by planned departure; empty windows are skipped). Window by window, the window's flights (the
+*free* flights) are solved exactly by the inner solver (``inner`` = ``"cpsat"`` or ``"highs"``)
+on a **sub-problem** in which the flights of earlier windows are *fixed* at their decisions:
+
+- every earlier **operated** flight that matters to a free flight — it conflicts with one (a pair
+  of ``problem.conflicts``), or it is the last operated earlier flight of a free flight's aircraft
+  (the turnaround rule of the model is implied by the last operated one) — enters the sub-problem
+  as a *fixed* flight: planned departure = its decided departure, delay bound 0 (``max_delay_s
+  = 0``), and it **must operate**. The model has no "must operate" notion, so it is added by a
+  small extension of the inner model built here: ``operate[i] == 1`` in the CP-SAT model of
+  :func:`uamopt.solvers.cpsat.build_cpsat`, ``m.operate[i].fix(1)`` in the Pyomo model of
+  :func:`uamopt.solvers.milp.build_model`. (Including them with delay bound 0 only and
+  post-checking would let the solver buy free flights by cancelling a fixed one.) Conflict
+  intervals are on actual departures, so they carry over unchanged; fixed–fixed pairs are
+  dropped (already satisfied);
+- a free return whose outbound was cancelled in an earlier window is cancelled (precedence);
+- the sub-problem keeps the global G, so its weighted objective is the global one restricted to
+  the window plus a constant.
+
+Per aircraft the decided flights are always a prefix of its chain (windows follow planned
+departure), so every constraint between a free flight and a decided one is in the sub-problem;
+hence a window decision that passes ``violations(sub, ...)`` with every fixed flight operated
+keeps the union feasible. A window whose inner solve fails (no incumbent, infeasible from
+rounding, a violation, a fixed flight cancelled) falls back to the greedy preliminary strategy on
+the sub-problem with the fixed flights placed first (they are mutually consistent, so they keep
+delay 0), and if even that cancels a fixed flight, to cancelling the window's free flights.
+The end result is asserted with ``violations(problem, ...) == []`` (else: the whole-problem greedy
+schedule, ``extras["fallback"]``).
+
+Lower bound (cheap, valid)
+--------------------------
+Drop all constraints except, for a set M of *disjoint* conflicting pairs, each pair's own
+conflict. The objective is separable per flight with c d ≥ 0, so a flight outside M contributes
+≥ −ω7 (operated on time), and a pair (p, q) ∈ M contributes ≥ min(−ω7, −2ω7 + ω6/G · dist),
+where dist is the least total delay d_p + d_q that moves δ = dep_q − dep_p from its planned value
+out of every forbidden interval within reach (∞ if no admissible δ: at most one operates), since
+|Δδ| ≤ d_p + d_q. Dropping constraints only lowers the minimum, so the sum is ≤ the optimum.
+M is a greedy maximum-improvement matching; dist is reduced by 2·TIME_TOL_S to stay valid under
+the feasibility tolerance. Lexicographic: the same with −1 per flight and dist/(ΣU + 1).
+(The sum of the windows' own bounds is *not* a bound of the whole problem.)
+
+Options (``[options]`` of a profile): ``window_s`` (900), ``inner`` ("cpsat"), ``window_time_limit_s``
+(default ``time_limit_s`` / number of non-empty windows), ``time_unit_s`` (CP-SAT, 0.01),
+``step_s`` (greedy fallback ΔT_a, 10). Status: ``feasible``, or ``time_limit`` if some window's
+inner solve stopped at its limit without proof. Registry line (``SOLVERS`` in __init__.py)::
+
+    "rolling": "uamopt.solvers.rolling",
+
+Until registered, call the module directly with any valid profile:
+``rolling.solve(problem, SolverProfile("cpsat", time_limit_s=60, options={"inner": "cpsat"}))``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+
+import numpy as np
+
+from uamopt.errors import UamoptError
+from uamopt.schedule.flights import TIME_TOL_S
+from uamopt.schedule.model import Schedule, SchedulingProblem, make_schedule, violations
+from uamopt.schedule.occupancy import ConflictTable
+from uamopt.solvers.greedy import Decoder, check_options, greedy_decisions
+from uamopt.solvers.milp import native_loaded, serve, solve_isolated
+
+KNOWN = {"window_s", "inner", "window_time_limit_s", "time_unit_s", "step_s"}
+
+
+# --- the cheap lower bound ---------------------------------------------------------------------
+def pair_matching_bound(problem: SchedulingProblem) -> float:
+    """A valid lower bound of the optimum (module docstring): disjoint conflicting pairs, each alone."""
+    n = problem.n_flights
+    pairs, ptr, intervals = problem.conflict_arrays
+    lexi = problem.objective_kind == "lexicographic"
+    per_flight = 1.0 if lexi else float(problem.weights[1])
+    per_delay = 1.0 / (float(np.sum(problem.delay_upper_s)) + 1.0) if lexi else float(problem.weights[0]) / problem.aircraft_count
+    if len(pairs) == 0:
+        return -per_flight * n
+    dep, upper = problem.planned_departure_s, problem.delay_upper_s
+    p, q = pairs[:, 0], pairs[:, 1]
+    delta0 = dep[q] - dep[p]
+    row_pair = np.repeat(np.arange(len(pairs)), np.diff(ptr))
+    lo, hi = intervals[:, 0], intervals[:, 1]
+    d0 = delta0[row_pair]
+    inside = (lo < d0) & (d0 < hi)
+    down = np.where(lo >= d0 - upper[p[row_pair]], d0 - lo, np.inf)  # p delayed / q earlier: δ down to lo
+    up = np.where(hi <= d0 + upper[q[row_pair]], hi - d0, np.inf)  # q delayed: δ up to hi
+    dist = np.zeros(len(pairs))
+    rows = np.flatnonzero(inside)
+    dist[row_pair[rows]] = np.minimum(down[rows], up[rows])
+    dist = np.maximum(0.0, dist - 2 * TIME_TOL_S)
+    gain = np.minimum(per_flight, per_delay * dist)  # above the −2·per_flight of two free flights
+    used = np.zeros(n, dtype=bool)
+    total = 0.0
+    for k in np.argsort(-gain, kind="stable"):
+        if gain[k] <= 0:
+            break
+        a, b = int(p[k]), int(q[k])
+        if not (used[a] or used[b]):
+            used[a] = used[b] = True
+            total += float(gain[k])
+    return -per_flight * n + total
+
+
+# --- sub-problems -------------------------------------------------------------------------------
+def subproblem(problem: SchedulingProblem, free: np.ndarray, fixed: np.ndarray, departure: np.ndarray
+               ) -> tuple[SchedulingProblem, np.ndarray, np.ndarray]:
+    """The window's model: ``free`` flights as they are, ``fixed`` flights at ``departure`` with delay
+    bound 0 (to be forced operated by the caller). Returns (sub-problem, global index of each sub
+    flight, fixed mask over sub flights)."""
+    fs = problem.flights
+    n = problem.n_flights
+    index = np.union1d(free, fixed)
+    pos = np.full(n, -1, dtype=np.int64)
+    pos[index] = np.arange(len(index))
+    is_fixed = np.zeros(n, dtype=bool)
+    is_fixed[fixed] = True
+    flights = tuple(dataclasses.replace(fs.flights[i], planned_departure_s=float(departure[i]), max_delay_s=0.0)
+                    if is_fixed[i] else fs.flights[i] for i in index.tolist())
+    sub_fs = dataclasses.replace(fs, flights=flights)
+    # the chains in the original order (a fixed flight's new departure could reorder a re-sort), and
+    # the original precedence (a sub-chain may start with a return): set the cached views directly
+    chains = []
+    for chain in fs.chains:
+        members = pos[chain]
+        members = members[members >= 0]
+        if len(members):
+            chains.append(members)
+    req = problem.requires[index]
+    sub_req = np.where(req >= 0, pos[np.maximum(req, 0)], -1)
+    free_mask = ~is_fixed[index]
+    if np.any(free_mask & (req >= 0) & (sub_req < 0)):
+        raise UamoptError("a free return's outbound is missing from its window's sub-problem", "solver rolling",
+                          "report this as a bug")
+    for key in ("chains", "leg", "previous", "requires", "aircraft_index"):
+        sub_fs.__dict__.pop(key, None)
+    sub_fs.__dict__["chains"] = tuple(chains)
+    sub_fs.__dict__["requires"] = sub_req
+    # conflicts with at least one free flight, re-indexed (pos is increasing, so p < q and the order hold)
+    c = problem.conflicts
+    keep = (pos[c.p] >= 0) & (pos[c.q] >= 0) & ~(is_fixed[c.p] & is_fixed[c.q])
+    counts = np.diff(c.ptr)
+    row_keep = np.repeat(keep, counts)
+    table = ConflictTable(p=pos[c.p[keep]], q=pos[c.q[keep]],
+                          ptr=np.concatenate([[0], np.cumsum(counts[keep])]).astype(np.int64),
+                          intervals=c.intervals[row_keep])
+    sub = SchedulingProblem(flights=sub_fs, conflicts=table, weights=problem.weights,
+                            aircraft_count=problem.aircraft_count, objective_kind=problem.objective_kind)
+    return sub, index, is_fixed[index]
+
+
+def _greedy_fixed_first(sub: SchedulingProblem, fixed: np.ndarray, step_s: float) -> tuple[np.ndarray, np.ndarray]:
+    """The preliminary strategy with the fixed flights placed first (by departure), then the free ones."""
+    dep = sub.planned_departure_s
+    order = np.lexsort((np.arange(sub.n_flights), dep, ~fixed))
+    operated, delay = Decoder.from_problem(sub, order).decode(sub, np.zeros(sub.n_flights, dtype=np.int64), step_s)
+    return operated[0], delay[0]
+
+
+def _inner_cpsat(sub: SchedulingProblem, fixed: np.ndarray, hint: tuple[np.ndarray, np.ndarray], limit_s: float,
+                 threads: int, seed: int, unit_s: float) -> tuple[np.ndarray, np.ndarray, bool] | None:
+    from ortools.sat.python import cp_model
+
+    from uamopt.solvers.cpsat import build_cpsat
+
+    model, operate, delay, *_ = build_cpsat(sub, unit_s)
+    for i in np.flatnonzero(fixed).tolist():
+        model.add(operate[i] == 1)  # the "must operate" extension
+    h_op, h_d = hint
+    for i in range(sub.n_flights):
+        model.add_hint(operate[i], bool(h_op[i]))
+        model.add_hint(delay[i], int(round(h_d[i] / unit_s)) if h_op[i] else 0)
+    solver = cp_model.CpSolver()
+    solver.parameters.max_time_in_seconds = float(limit_s)
+    solver.parameters.num_workers = int(threads)
+    solver.parameters.random_seed = int(seed)
+    if threads == 1:
+        solver.parameters.linearization_level = 2
+    else:
+        solver.parameters.subsolvers.extend(["max_lp", "default_lp"])
+    code = solver.solve(model)
+    if code not in (cp_model.OPTIMAL, cp_model.FEASIBLE):
+        return None
+    operated = np.array([solver.boolean_value(v) for v in operate])
+    delay_s = np.array([solver.value(v) for v in delay], dtype=float) * unit_s
+    return operated, delay_s, code == cp_model.OPTIMAL
+
+
+def _inner_highs(sub: SchedulingProblem, fixed: np.ndarray, limit_s: float, threads: int, seed: int
+                 ) -> tuple[np.ndarray, np.ndarray, bool] | None:
+    import pyomo.environ as pyo
+    from pyomo.contrib.solver.common.factory import SolverFactory
+    from pyomo.contrib.solver.common.results import SolutionStatus, TerminationCondition
+
+    from uamopt.solvers import milp
+
+    m = milp.build_model(sub)
+    for i in np.flatnonzero(fixed).tolist():
+        m.operate[i].fix(1)  # the "must operate" extension
+    result = SolverFactory(milp.SOLVER_NAME).solve(
+        m, time_limit=float(limit_s), threads=int(threads), solver_options={"mip_rel_gap": 0.0, "random_seed": int(seed)},
+        load_solutions=False, raise_exception_on_nonoptimal_result=False)
+    if result.solution_status not in (SolutionStatus.optimal, SolutionStatus.feasible):
+        return None
+    result.solution_loader.load_vars()
+    operated = np.array([pyo.value(m.operate[f]) > 0.5 for f in range(sub.n_flights)])
+    delay = milp.least_delays(sub, operated, milp._choices(m, operated))
+    if delay is None:
+        delay = np.where(operated, np.clip([pyo.value(m.delay[f]) for f in range(sub.n_flights)], 0.0, sub.delay_upper_s), 0.0)
+    proved = result.termination_condition == TerminationCondition.convergenceCriteriaSatisfied
+    return operated, delay, proved
+
+
+# --- the solver -----------------------------------------------------------------------------------
+def _options(profile) -> dict:
+    check_options(profile.options, KNOWN, "rolling")
+    o = dict(profile.options)
+    inner = str(o.get("inner", "cpsat"))
+    if inner not in ("cpsat", "highs"):
+        raise UamoptError(f"unknown inner solver '{inner}'", "solver rolling", "use inner = \"cpsat\" or \"highs\"")
+    window = float(o.get("window_s", 900.0))
+    if not (math.isfinite(window) and window > 0):
+        raise UamoptError(f"window_s must be positive, got {window}", "solver rolling", "give a window in seconds, e.g. 900")
+    return {"inner": inner, "window_s": window, "window_time_limit_s": o.get("window_time_limit_s"),
+            "time_unit_s": float(o.get("time_unit_s", 0.01)), "step_s": float(o.get("step_s", 10.0))}
+
+
+def solve(problem: SchedulingProblem, profile) -> Schedule:
+    """Rolling horizon; runs in a worker process when the inner solver's package cannot load here
+    (highspy and OR-Tools ship clashing HiGHS builds, see milp.py)."""
+    inner = _options(profile)["inner"]
+    if inner == "cpsat":
+        from uamopt.solvers.cpsat import _importable_here
+        if not _importable_here() and native_loaded("highspy"):
+            return solve_isolated(__name__, problem, profile)
+    else:
+        from pyomo.contrib.solver.common.factory import SolverFactory
+
+        from uamopt.solvers.milp import SOLVER_NAME
+        solver = SolverFactory(SOLVER_NAME)
+        if (solver is None or not solver.available()) and native_loaded("ortools"):
+            return solve_isolated(__name__, problem, profile)
+    return solve_here(problem, profile)
+
+
+def solve_here(problem: SchedulingProblem, profile) -> Schedule:
+    """:func:`solve` in this process."""
+    o = _options(profile)
+    start = time.perf_counter()
+    n = problem.n_flights
+    dep0 = problem.planned_departure_s
+    order = np.lexsort((np.arange(n), dep0))
+    t0 = float(dep0[order[0]]) if n else 0.0
+    window_of = np.floor((dep0 - t0) / o["window_s"]).astype(np.int64)
+    windows = [order[window_of[order] == w] for w in np.unique(window_of)]
+    limit = float(o["window_time_limit_s"]) if o["window_time_limit_s"] is not None else profile.time_limit_s / max(len(windows), 1)
+    aircraft = problem.flights.aircraft_index
+    pairs = problem.conflict_arrays[0]
+    decided = np.zeros(n, dtype=bool)
+    operated = np.zeros(n, dtype=bool)
+    delay = np.zeros(n)
+    last_operated = np.full(problem.flights.n_aircraft, -1, dtype=np.int64)
+    stats = {"windows": len(windows), "window_time_limit_s": limit, "inner": o["inner"], "proved": 0,
+             "unproved": 0, "greedy_windows": 0, "cancelled_windows": 0, "max_subproblem": 0}
+    for free in windows:
+        free = np.sort(free)
+        # a return whose outbound was cancelled earlier cannot fly
+        req = problem.requires[free]
+        dead = (req >= 0) & decided[np.maximum(req, 0)] & ~operated[np.maximum(req, 0)]
+        decided[free[dead]] = True
+        free = free[~dead]
+        if len(free) == 0:
+            continue
+        is_free = np.zeros(n, dtype=bool)
+        is_free[free] = True
+        on = operated & decided
+        touch = (is_free[pairs[:, 0]] & on[pairs[:, 1]]) | (is_free[pairs[:, 1]] & on[pairs[:, 0]])
+        fixed = np.union1d(np.where(is_free[pairs[touch, 0]], pairs[touch, 1], pairs[touch, 0]),
+                           last_operated[np.unique(aircraft[free])])
+        fixed = fixed[fixed >= 0].astype(np.int64)
+        sub, index, fixed_mask = subproblem(problem, free, fixed, dep0 + delay)
+        stats["max_subproblem"] = max(stats["max_subproblem"], sub.n_flights)
+        hint = _greedy_fixed_first(sub, fixed_mask, o["step_s"])
+        answer = None
+        try:
+            if o["inner"] == "cpsat":
+                answer = _inner_cpsat(sub, fixed_mask, hint, limit, profile.threads, profile.seed, o["time_unit_s"])
+            else:
+                answer = _inner_highs(sub, fixed_mask, limit, profile.threads, profile.seed)
+        except UamoptError:
+            answer = None
+        ok = answer is not None and bool(np.all(answer[0][fixed_mask])) and not violations(sub, answer[0], answer[1])
+        if ok:
+            stats["proved" if answer[2] else "unproved"] += 1
+            sub_op, sub_d = answer[0], answer[1]
+        else:
+            stats["greedy_windows"] += 1
+            sub_op, sub_d = hint
+            if not np.all(sub_op[fixed_mask]) or violations(sub, sub_op, sub_d):
+                stats["cancelled_windows"] += 1
+                sub_op, sub_d = fixed_mask.copy(), np.zeros(sub.n_flights)
+        free_rows = ~fixed_mask
+        g = index[free_rows]
+        operated[g] = sub_op[free_rows]
+        delay[g] = np.where(sub_op[free_rows], sub_d[free_rows], 0.0)
+        decided[g] = True
+        for f in free.tolist():  # free is in index order; chains are by departure: take the latest operated
+            if operated[f]:
+                a = aircraft[f]
+                if last_operated[a] < 0 or dep0[f] > dep0[last_operated[a]] or (dep0[f] == dep0[last_operated[a]] and f > last_operated[a]):
+                    last_operated[a] = f
+    bad = violations(problem, operated, delay)
+    if bad:  # cannot happen by construction; never return an infeasible schedule
+        stats["fallback"] = f"whole-problem greedy ({len(bad)} violations, first: {bad[0]})"
+        operated, delay = greedy_decisions(problem, o["step_s"])
+    bound = pair_matching_bound(problem)
+    status = "time_limit" if stats["unproved"] else "feasible"
+    stats["bound_of"] = "pair-matching relaxation (rolling.py docstring)"
+    return make_schedule(problem, "rolling", status, operated, delay, bound=bound,
+                         solve_seconds=time.perf_counter() - start, seed=profile.seed, extras=stats)
+
+
+if __name__ == "__main__":
+    serve(solve_here)
