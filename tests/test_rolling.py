@@ -13,7 +13,13 @@ from conftest import PAPER_CASE
 
 from uamopt.grid import AirspaceGrid
 from uamopt.scenario import load_scenario
-from uamopt.schedule import build_problem, evaluate, generate_plan, straight_network, violations
+from uamopt.schedule import (
+    build_problem,
+    evaluate,
+    generate_plan,
+    straight_network,
+    violations,
+)
 from uamopt.solvers import SolverProfile, milp, rolling
 
 OBJ_TOL = 1e-6

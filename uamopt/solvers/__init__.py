@@ -4,7 +4,7 @@ A solver never builds the model: it takes a :class:`~uamopt.schedule.SchedulingP
 and returns a :class:`~uamopt.schedule.Schedule` (status, objective, bound, gap, time, seed).
 Profiles are TOML files in ``solvers/`` naming a solver and its options::
 
-    solver = "highs"        # greedy | ga | soa | highs | cpsat
+    solver = "highs"        # greedy | ga | soa | highs | cpsat | rolling
     time_limit_s = 60.0
     seed = 0
     threads = 2
@@ -32,6 +32,7 @@ SOLVERS = {
     "soa": "uamopt.solvers.genetic",
     "highs": "uamopt.solvers.milp",
     "cpsat": "uamopt.solvers.cpsat",
+    "rolling": "uamopt.solvers.rolling",
 }
 PROFILE_DIR = Path(__file__).resolve().parents[2] / "solvers"
 _KEYS = {"solver", "time_limit_s", "seed", "threads", "options", "description"}

@@ -176,7 +176,7 @@ def _inner_cpsat(sub: SchedulingProblem, fixed: np.ndarray, hint: tuple[np.ndarr
     h_op, h_d = hint
     for i in range(sub.n_flights):
         model.add_hint(operate[i], bool(h_op[i]))
-        model.add_hint(delay[i], int(round(h_d[i] / unit_s)) if h_op[i] else 0)
+        model.add_hint(delay[i], int(np.rint(h_d[i] / unit_s)) if h_op[i] else 0)
     solver = cp_model.CpSolver()
     solver.parameters.max_time_in_seconds = float(limit_s)
     solver.parameters.num_workers = int(threads)
