@@ -25,3 +25,16 @@ def paper_run():
     from uamopt.stages import compute_risk
 
     return compute_risk(load_scenario(PAPER_CASE))
+
+
+@pytest.fixture(scope="session")
+def paper_straight_plan():
+    """(scenario, grid, straight network, generated plan) of the paper case, seed 0."""
+    from uamopt.grid import AirspaceGrid
+    from uamopt.scenario import load_scenario
+    from uamopt.schedule import generate_plan, straight_network
+
+    scenario = load_scenario(PAPER_CASE)
+    grid = AirspaceGrid.from_extent(scenario.grid.cell, scenario.grid.extent)
+    network = straight_network(scenario, grid)
+    return scenario, grid, network, generate_plan(scenario, network, seed=0)

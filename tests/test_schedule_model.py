@@ -7,11 +7,8 @@ import json
 
 import numpy as np
 import pytest
-from conftest import PAPER_CASE
 
 from uamopt.errors import InputFileError, UamoptError
-from uamopt.grid import AirspaceGrid
-from uamopt.scenario import load_scenario
 from uamopt.schedule import (
     build_problem,
     evaluate,
@@ -20,7 +17,6 @@ from uamopt.schedule import (
     load_flights,
     make_schedule,
     save_flights,
-    straight_network,
     violations,
     write_schedule,
 )
@@ -28,11 +24,8 @@ from uamopt.schedule.flights import flightset_to_dict
 
 
 @pytest.fixture(scope="module")
-def paper():
-    scenario = load_scenario(PAPER_CASE)
-    grid = AirspaceGrid.from_extent(scenario.grid.cell, scenario.grid.extent)
-    network = straight_network(scenario, grid)
-    return scenario, grid, network, generate_plan(scenario, network, seed=0)
+def paper(paper_straight_plan):
+    return paper_straight_plan
 
 
 def test_eq23_gives_six_flights_per_aircraft():

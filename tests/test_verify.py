@@ -8,20 +8,15 @@ import re
 
 import numpy as np
 import pytest
-from conftest import PAPER_CASE
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from uamopt.errors import InputFileError
-from uamopt.grid import AirspaceGrid
-from uamopt.scenario import load_scenario
 from uamopt.schedule import (
     Flight,
     FlightSet,
     build_problem,
-    generate_plan,
     make_schedule,
-    straight_network,
     violations,
     write_schedule,
 )
@@ -29,10 +24,9 @@ from uamopt.schedule.verify import verify_dir
 
 
 @pytest.fixture(scope="module")
-def paper_problem():
-    scenario = load_scenario(PAPER_CASE)
-    grid = AirspaceGrid.from_extent(scenario.grid.cell, scenario.grid.extent)
-    return build_problem(generate_plan(scenario, straight_network(scenario, grid), seed=0), scenario)
+def paper_problem(paper_straight_plan):
+    scenario, _, _, flights = paper_straight_plan
+    return build_problem(flights, scenario)
 
 
 def first_fit(problem, order=None):
