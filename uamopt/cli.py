@@ -253,12 +253,10 @@ def cmd_reproduce(args) -> int:
 
 
 def _initial_plan(scenario, network, seed: int):
-    """The generated initial flight plan with the scenario's [schedule] knobs."""
-    from uamopt.solvers.calibration import paper_case_plan
+    """The generated initial flight plan with the scenario's [schedule] keys."""
+    from uamopt.schedule import generate_plan
 
-    sc = scenario.schedule
-    return paper_case_plan(scenario, network, seed, max_delay_scale=sc.max_delay_scale,
-                           first_departure_window_s=sc.first_departure_window_s, departure_step_s=sc.departure_step_s)
+    return generate_plan(scenario, network, seed)
 
 
 def _scheduling_problem(scenario, args, bar):

@@ -96,7 +96,11 @@ def endpoint_cell(model: PlanningModel, point, label: str) -> tuple[int, int, in
         raise UamoptError(f"{label} altitude {point[2]:g} m is outside the band {low:g}-{high:g} m (Eq. 14)", where,
                           "choose an altitude inside the band")
     if field_.obstacle[cell]:
-        raise UamoptError(f"{label} is inside a building (cell {cell})", where, "move it above the roofs or into the street")
+        if field_.city.building_height[cell[:2]] > 0:
+            raise UamoptError(f"{label} is inside a building (cell {cell})", where, "move it above the roofs or into the street")
+        raise UamoptError(f"{label} is inside a low obstacle (cell {cell}: surface up to "
+                          f"{field_.city.surface_height[cell[:2]]:.1f} m, below city.building_min_height_m, e.g. trees)",
+                          where, "move it above the obstacle")
     if field_.no_fly[cell]:
         raise UamoptError(f"{label} is inside a no-fly zone (cell {cell})", where, "move it out of the zone")
     if not model.admissible[cell]:

@@ -121,6 +121,7 @@ class FlightSet:
     service_end_s: float = DEFAULT_SERVICE_S  # T_f, s (Eqs. 23, 26)
     outbound_gap_s: float = 240.0  # T_D, s (Eq. 28)
     return_gap_s: float = 360.0  # T_R, s (Eq. 28)
+    notes: tuple[str, ...] = ()  # how the generator adapted the plan (written to summary.json)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "cell", tuple(float(c) for c in self.cell))

@@ -54,6 +54,7 @@ class SchedulingProblem:
     weights: tuple[float, float] = (0.6, 0.4)  # (ω6, ω7), Eq. 20
     aircraft_count: int = 0  # G, Eq. 21: the number of distinct aircraft in ``flights`` (0: fill it in)
     objective_kind: ObjectiveKind = "weighted"
+    time_step_s: float = 10.0  # ΔT_a (Table B.3): the heuristics' delay grid unless a profile sets step_s
 
     def __post_init__(self) -> None:
         if self.objective_kind not in ("weighted", "lexicographic"):
@@ -115,13 +116,14 @@ def build_problem(
     """Compute the pair conflicts of ``flightset`` and assemble the model.
 
     ``weights`` default to the scenario's (ω6, ω7) = (0.6, 0.4); G defaults to the number of
-    distinct aircraft in the flight set (INTERFACES.md).
+    distinct aircraft in the flight set (INTERFACES.md); ΔT_a is ``schedule.time_step_s``.
     """
     if weights is None:
         weights = tuple(scenario.schedule.weights) if scenario is not None else (0.6, 0.4)  # type: ignore[assignment]
     return SchedulingProblem(
         flights=flightset, conflicts=conflict_table(flightset), weights=tuple(float(w) for w in weights),  # type: ignore[arg-type]
         aircraft_count=flightset.n_aircraft, objective_kind=objective,
+        time_step_s=float(scenario.schedule.time_step_s) if scenario is not None else 10.0,
     )
 
 
@@ -254,6 +256,8 @@ def write_schedule(out_dir: str | Path, problem: SchedulingProblem, schedule: Sc
         "weights": list(problem.weights), "objective_kind": problem.objective_kind,
         "aircraft": problem.aircraft_count, "flights": problem.n_flights,
     }
+    if fs.notes:
+        summary["plan_notes"] = list(fs.notes)
     with staged_output(out_dir) as stage:
         save_flights(stage / "flights.json", fs)
         with open(stage / "schedule.csv", "w", newline="", encoding="utf-8") as fh:
