@@ -183,11 +183,16 @@ class TracksConfig(_Section):
         "in the node priority φ′ of Eq. 34, not carried along the path ('priority')"
     )
     risk_model: Literal["binary", "continuous"] = Field("binary", description="Eq. 9 field or Eq. 8 field")
-    origin: tuple[float, float, float] = Field(
-        (300.0, 300.0, 120.0), description="P_O, default origin of `uamopt plan`, m (Table B.3: (30, 30, 120) in 10 m units)"
+    route: tuple[str, str] | None = Field(
+        None, description="the two vertiports (names) of the single-track comparison (Table 2, Table 4, Fig. 21) "
+        "and the default of `uamopt plan`, flown at network.cruise_altitude_m; omitted: the first vertiport and the "
+        "one farthest from it (V1 -> V4 = P_O -> P_D of Table B.3 in the paper case)"
     )
-    destination: tuple[float, float, float] = Field(
-        (2220.0, 4220.0, 120.0), description="P_D, default destination of `uamopt plan`, m (Table B.3: (222, 422, 120))"
+    origin: tuple[float, float, float] | None = Field(
+        None, description="P_O as x, y, z in metres, overriding tracks.route's first vertiport"
+    )
+    destination: tuple[float, float, float] | None = Field(
+        None, description="P_D as x, y, z in metres, overriding tracks.route's second vertiport"
     )
     table2_cell_m: PositiveFloat = Field(
         10.0, description="cell side (m) of the Table 2 comparison in `uamopt reproduce` (the paper's Table 2 is "
