@@ -11,7 +11,6 @@ import sys
 import time
 from pathlib import Path
 
-import numpy as np
 
 from uamopt.errors import UamoptError
 
@@ -103,19 +102,17 @@ def _plan_stage(scenario, model, origin, destination, stage: Path, bar) -> dict:
     return doc
 
 
-def _network_stage(scenario, model, stage: Path, bar) -> dict:
+def _network_stage(scenario, model, stage: Path, bar):
     """Plan every route in both directions and write network.json and network.png."""
     from uamopt.outputs import write_json
-    from uamopt.planning.network import network_document, plan_network
+    from uamopt.planning.network import plan_network
     from uamopt.plot_tracks import plot_network
 
     bar.set_description("network")
     network = plan_network(model, progress=bar)
-    doc = network_document(model, network)
-    write_json(stage / "network.json", doc)
-    plot_network(model, {k: np.asarray(v["waypoints"]) for k, v in doc["routes"].items()}, stage / "network.png",
-                 vertiports=scenario.network.vertiports)
-    return {"doc": doc, "plans": network}
+    write_json(stage / "network.json", network.to_document())
+    plot_network(model, network.waypoints(), stage / "network.png", vertiports=scenario.network.vertiports)
+    return network
 
 
 def cmd_plan(args) -> int:
@@ -140,8 +137,8 @@ def cmd_network(args) -> int:
     check_out_dir(args.out)
     with _progress(2 + 2 * 10, "network") as bar, staged_output(args.out) as stage:
         _, model = _planning(scenario, bar)
-        result = _network_stage(scenario, model, stage, bar)
-    print(f"network: {len(result['doc']['routes'])} tracks -> {Path(args.out) / 'network.json'}")
+        network = _network_stage(scenario, model, stage, bar)
+    print(f"network: {len(network)} tracks -> {Path(args.out) / 'network.json'}")
     return 0
 
 
@@ -176,7 +173,7 @@ def _plan_at(scenario, side: float, extent) -> tuple:
 REPRODUCE_SOLVERS = ("greedy", "ga", "soa", "highs", "cpsat")
 
 
-def _reproduce_schedules(scenario, model, network_doc: dict, stage: Path, bar) -> list[str]:
+def _reproduce_schedules(scenario, model, network, stage: Path, bar) -> list[str]:
     """Table 3 / Fig. 19: every solver profile on the paper-case plan over the planned network."""
     from uamopt.plot_schedule import plot_delay_comparison, plot_gantt
     from uamopt.report import is_paper_schedule, table3_section
@@ -184,7 +181,6 @@ def _reproduce_schedules(scenario, model, network_doc: dict, stage: Path, bar) -
     from uamopt.schedule.verify import verify_dir
     from uamopt.solvers import load_profile, solve
 
-    network = {k: np.asarray(v["waypoints"]) for k, v in network_doc["routes"].items()}
     flights = _initial_plan(scenario, network, scenario.schedule.plan_seed)
     sections = []
     for objective in (scenario.schedule.objective, "lexicographic" if scenario.schedule.objective == "weighted" else "weighted"):
@@ -244,13 +240,13 @@ def cmd_reproduce(args) -> int:
         bar.set_description("pareto front")
         fronts = {flag: weight_sweep(model, origin, destination, 9, buffer=flag) for flag in (False, True)}
         plot_pareto(fronts[True], stage / "pareto.png", title=f"{scenario.name}: Eq. 10 + μ·R(t) trade-off")
-        sched_sections = _reproduce_schedules(scenario, model, network["doc"], stage, bar)
+        sched_sections = _reproduce_schedules(scenario, model, network, stage, bar)
         sections = [risk_section(scenario, summary), table2_section(fine, fine_model, tracks, paper=paper),
                     table2_section(v_scenario, v_model, v_tracks, figure=False, paper=paper,
                                    title=f"Table 2 analogue with the variant tracks.buffer_measure = \"{other}\""),
                     table4_section(scenario, table4, paper=paper),
                     pareto_section(scenario, model, fronts, (origin.label, destination.label)),
-                    network_section(scenario, network["doc"])] + sched_sections
+                    network_section(scenario, network.to_document())] + sched_sections
         write_report(stage / "report.md", scenario, sections)
     print(f"report: {Path(args.out) / 'report.md'}")
     return 0
@@ -267,7 +263,7 @@ def _scheduling_problem(scenario, args, bar):
     """The flight set (given, or generated on the planned or given network) and its model."""
     from uamopt.grid import build_grid
     from uamopt.planning import planning_model
-    from uamopt.planning.network import load_network, network_document, plan_network
+    from uamopt.planning.network import load_network, plan_network
     from uamopt.schedule import build_problem, load_flights
     from uamopt.stages import compute_risk
 
@@ -279,8 +275,7 @@ def _scheduling_problem(scenario, args, bar):
     else:
         bar.set_description("network")
         model = planning_model(scenario, compute_risk(scenario).field)
-        doc = network_document(model, plan_network(model))
-        network = {k: np.asarray(v["waypoints"]) for k, v in doc["routes"].items()}
+        network = plan_network(model)
     bar.update(1)
     if args.flights:
         flights = load_flights(args.flights, scenario, grid, network)

@@ -271,6 +271,33 @@ class TrackPlan:
     midpoint: TrackStage | None = None
     warmup_seconds: float = 0.0  # compiling the search before the first stage (not in any stage's time)
 
+    def to_frame(self):
+        """One row per stage (Table 2): risk_cost C_R, transport_cost C_T, objective, buffer_cost,
+        length_m, n_waypoints, seconds (pandas DataFrame indexed by stage)."""
+        import pandas as pd
+
+        rows = [{"stage": name, "risk_cost": s.risk_cost, "transport_cost": s.transport_cost,
+                 "objective": s.objective, "buffer_cost": s.buffer_cost, "length_m": s.length_m,
+                 "n_waypoints": s.n_waypoints, "seconds": s.seconds} for name, s in self.stages.items()]
+        return pd.DataFrame(rows).set_index("stage")
+
+    @classmethod
+    def from_dict(cls, doc: dict) -> TrackPlan:
+        """The plan of a ``tracks.json`` document (:meth:`as_dict`)."""
+        def stage(name: str, d: dict) -> TrackStage:
+            core = {"waypoints", "risk_cost", "transport_cost", "objective", "buffer_cost", "n_waypoints",
+                    "length_m", "seconds"}
+            return TrackStage(name=name, waypoints=np.asarray(d["waypoints"], dtype=float), risk_cost=float(d["risk_cost"]),
+                              transport_cost=float(d["transport_cost"]), objective=float(d["objective"]),
+                              buffer_cost=float(d.get("buffer_cost", 0.0)), length_m=float(d["length_m"]),
+                              seconds=float(d["seconds"]), extra={k: v for k, v in d.items() if k not in core})
+
+        mid = doc.get("equivalent_midpoint_rule")
+        return cls(tuple(map(float, doc["origin"])), tuple(map(float, doc["destination"])),  # type: ignore[arg-type]
+                   {name: stage(name, d) for name, d in doc["stages"].items()},
+                   midpoint=stage("equivalent", mid) if mid else None,
+                   warmup_seconds=float(doc.get("warmup_seconds", 0.0)))
+
     def as_dict(self) -> dict:
         out = {"stages": {k: v.as_dict() for k, v in self.stages.items()},
                "origin": list(self.origin), "destination": list(self.destination),

@@ -143,8 +143,9 @@ def generate_plan(
     ----------
     scenario : Scenario
         Supplies the routes, v_g (``aircraft.cruise_speed_mps``), T_D, T_R, χ, G, r and the cell.
-    network : mapping route name -> (n, 3) waypoints
-        Both directions of every route, named ``"a-b"`` (e.g. :func:`straight_network`).
+    network : RouteNetwork, or mapping route name -> (n, 3) waypoints
+        Both directions of every route, named ``"a-b"`` (:func:`~uamopt.planning.network.plan_network`
+        or :func:`straight_network`).
     seed : int
         Seeds the first departures.
     aircraft : int, optional
@@ -177,6 +178,8 @@ def generate_plan(
         A route missing from ``network``, a bad scale, or flights that cannot fit in the service
         window even with no slack.
     """
+    if callable(getattr(network, "waypoints", None)):  # a RouteNetwork
+        network = network.waypoints()
     sched = scenario.schedule
     n_aircraft = sched.aircraft if aircraft is None else int(aircraft)
     total = sched.flights if flights is None else int(flights)
