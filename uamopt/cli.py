@@ -238,14 +238,14 @@ def cmd_reproduce(args) -> int:
         v_scenario, v_model, v_plan, _ = _plan_at(variant, t2, run.grid.extent)
         v_tracks = {**v_plan.as_dict()}
         bar.set_description("pareto front")
-        fronts = {flag: weight_sweep(model, origin, destination, 9, buffer=flag) for flag in (False, True)}
+        fronts = {flag: weight_sweep(fine_model, origin, destination, 9, buffer=flag) for flag in (False, True)}
         plot_pareto(fronts[True], stage / "pareto.png", title=f"{scenario.name}: Eq. 10 + μ·R(t) trade-off")
         sched_sections = _reproduce_schedules(scenario, model, network, stage, bar)
         sections = [risk_section(scenario, summary), table2_section(fine, fine_model, tracks, paper=paper),
                     table2_section(v_scenario, v_model, v_tracks, figure=False, paper=paper,
                                    title=f"Table 2 analogue with the variant tracks.buffer_measure = \"{other}\""),
                     table4_section(scenario, table4, paper=paper),
-                    pareto_section(scenario, model, fronts, (origin.label, destination.label)),
+                    pareto_section(fine, fine_model, fronts, (origin.label, destination.label)),
                     network_section(scenario, network.to_document())] + sched_sections
         write_report(stage / "report.md", scenario, sections)
     print(f"report: {Path(args.out) / 'report.md'}")
