@@ -16,7 +16,8 @@ import tomllib
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, PrivateAttr, ValidationError, ValidationInfo, field_validator
+from pydantic import (BaseModel, ConfigDict, Field, PrivateAttr, ValidationError, ValidationInfo, field_validator,
+                      model_validator)
 
 from uamopt.errors import ScenarioError
 
@@ -139,6 +140,29 @@ def _paper_vertiports() -> tuple[Vertiport, ...]:
     return tuple(Vertiport(name=n, x=10.0 * x, y=10.0 * y) for n, (x, y) in pts.items())
 
 
+def random_vertiports(n: int, extent_m: tuple[float, float], *, margin_m: float = 300.0, seed: int = 0,
+                      spacing_m: float = 500.0) -> tuple[Vertiport, ...]:
+    """``n`` vertiports V1..Vn at seeded random whole-metre points of [margin, extent − margin]²,
+    at least ``spacing_m`` apart.
+
+    >>> [(v.name, v.x, v.y) for v in random_vertiports(2, (2000.0, 2000.0), seed=1)]
+    [('V1', 1017.0, 1631.0), ('V2', 502.0, 1628.0)]
+    """
+    import numpy as np
+
+    rng = np.random.default_rng(seed)
+    pts: list[tuple[float, float]] = []
+    for _ in range(1000 * n):
+        if len(pts) == n:
+            break
+        p = tuple(float(np.round(rng.uniform(margin_m, e - margin_m))) for e in extent_m)
+        if all(math.dist(p, q) >= spacing_m for q in pts):
+            pts.append(p)  # type: ignore[arg-type]
+    if len(pts) < n:
+        raise ValueError(f"cannot place {n} vertiports {spacing_m:g} m apart in {extent_m[0]:g} x {extent_m[1]:g} m")
+    return tuple(Vertiport(name=f"V{i + 1}", x=x, y=y) for i, (x, y) in enumerate(pts))
+
+
 class NetworkConfig(_Section):
     """Vertiports and routes (Sec. 6.2). Routes default to every pair of vertiports."""
 
@@ -148,6 +172,25 @@ class NetworkConfig(_Section):
     vertiport_clearance_m: NonNegFloat = Field(
         150.0, description="radius kept free of buildings above h_min around each vertiport (synthetic city), m"
     )
+    random_vertiports: Annotated[int, Field(ge=2, le=200, strict=True)] | None = Field(
+        None, description="N: replace the vertiports by V1..VN at seeded random whole-metre points of the grid, "
+        "300 m from its edges and 500 m apart (benchmark instances); needs grid.extent"
+    )
+    vertiport_seed: Annotated[int, Field(ge=0, strict=True)] = Field(
+        0, description="seed of network.random_vertiports"
+    )
+    tracks: Literal["planned", "straight"] = Field(
+        "planned", description="the tracks flights fly: planned by A* through the city (Sec. 4.2), or straight "
+        "lines between vertiports, a->b at the cruise altitude and b->a r + 1 layers up (scheduler benchmarks)"
+    )
+
+    def route_list(self) -> list[tuple[str, str]]:
+        """The routes (a, b): ``routes`` as given, or every pair of vertiports in their order
+        (10 for V1–V5). Each route is flown both ways (a→b and b→a)."""
+        if self.routes is not None:
+            return [(a, b) for a, b in self.routes]
+        names = [v.name for v in self.vertiports]
+        return [(a, b) for i, a in enumerate(names) for b in names[i + 1:]]
 
     @field_validator("vertiports")
     @classmethod
@@ -261,6 +304,17 @@ class Scenario(_Section):
     network: NetworkConfig = NetworkConfig()
     tracks: TracksConfig = TracksConfig()
     schedule: ScheduleConfig = ScheduleConfig()
+
+    @model_validator(mode="after")
+    def _random_vertiports(self) -> "Scenario":
+        n = self.network.random_vertiports
+        if n is None:
+            return self
+        if self.grid.extent is None:
+            raise ValueError("network.random_vertiports needs grid.extent (the domain the vertiports are drawn in)")
+        ports = random_vertiports(n, (self.grid.extent[0], self.grid.extent[1]), seed=self.network.vertiport_seed)
+        object.__setattr__(self, "network", self.network.model_copy(update={"vertiports": ports, "routes": None}))
+        return self
 
     _base_dir: Path = PrivateAttr(default_factory=Path.cwd)
     _source: str = PrivateAttr(default="<defaults>")
