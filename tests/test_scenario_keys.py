@@ -174,3 +174,20 @@ def test_every_scenario_key_is_read(tmp_path, network_file, monkeypatch):
         assert text in (ROOT / "uamopt" / module).read_text(), key
     dead = sorted(every - read - set(READ_BY_REPRODUCE))
     assert not dead, f"scenario keys never read: {dead}"
+
+
+@pytest.mark.parametrize("override, fragment", [
+    ("grid.cell=[true,true,true]", "must be a number"),
+    ("city.seed=true", "valid integer"),
+    ('city.seed="7"', "valid integer"),
+    ("city.seed=-1", "greater than or equal to 0"),
+    ("schedule.plan_seed=-3", "greater than or equal to 0"),
+    ("grid.extent=[2e5,2e5,360]", "more than the limit"),
+    ("grid.memory_limit_gb=0.005", "more than the limit of 0.0 GB"),
+])
+def test_strict_types_and_memory_guard(tmp_path, capsys, override, fragment):
+    """Bad values are one `error:` line and exit 2 before anything is allocated or written."""
+    assert main(["risk", str(PAPER_CASE), "--set", override, "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: ") and err.count("\n") == 1 and fragment in err
+    assert not (tmp_path / "out").exists()
