@@ -176,7 +176,7 @@ def _plan_at(scenario, side: float, extent) -> tuple:
 REPRODUCE_SOLVERS = ("greedy", "ga", "soa", "highs", "cpsat")
 
 
-def _reproduce_schedules(scenario, model, network_doc: dict, stage: Path, bar) -> list[str]:
+def _reproduce_schedules(scenario, model, network_doc: dict, stage: Path, bar, provenance: dict | None = None) -> list[str]:
     """Table 3 / Fig. 19: every solver profile on the paper-case plan over the planned network."""
     from uamopt.plot_schedule import plot_delay_comparison, plot_gantt
     from uamopt.report import table3_section
@@ -194,7 +194,7 @@ def _reproduce_schedules(scenario, model, network_doc: dict, stage: Path, bar) -
             bar.set_description(f"schedule ({objective}): {name}")
             schedule = solve(problem, load_profile(name))
             folder = stage / "schedules" / objective / name
-            write_schedule(folder, problem, schedule)
+            write_schedule(folder, problem, schedule, extra=provenance)
             schedules[name], verified[name] = schedule, not verify_dir(folder)
             bar.update(1)
         suffix = "" if objective == scenario.schedule.objective else f"_{objective}"
@@ -241,7 +241,10 @@ def cmd_reproduce(args) -> int:
         fronts = {flag: weight_sweep(model, scenario.tracks.origin, scenario.tracks.destination, 9, buffer=flag)
                   for flag in (False, True)}
         plot_pareto(fronts[False], stage / "pareto.png", title=f"{scenario.name}: Eq. 10 trade-off (μ = 0)")
-        sched_sections = _reproduce_schedules(scenario, model, network["doc"], stage, bar)
+        from uamopt.export.frame import schedule_provenance
+
+        sched_sections = _reproduce_schedules(scenario, model, network["doc"], stage, bar,
+                                              schedule_provenance(scenario, args.set))
         sections = [risk_section(scenario, summary), table2_section(fine, fine_model, tracks),
                     table2_section(v_scenario, v_model, v_tracks, figure=False,
                                    title=f"Table 2 analogue with the variant tracks.buffer_measure = \"{other}\""),
@@ -296,15 +299,18 @@ def cmd_schedule(args) -> int:
     from uamopt.schedule.verify import verify_dir
     from uamopt.solvers import load_profile, solve
 
+    from uamopt.export.frame import schedule_provenance
+
     scenario = _load(args)
     profile = load_profile(args.solver)
     check_out_dir(args.out)
+    provenance = schedule_provenance(scenario, args.set)  # frame and scenario for the exports
     with _progress(3, "schedule") as bar:
         problem = _scheduling_problem(scenario, args, bar)
         bar.set_description(profile.solver)
         schedule = solve(problem, profile)
         bar.update(1)
-    write_schedule(args.out, problem, schedule)
+    write_schedule(args.out, problem, schedule, extra=provenance)
     problems = verify_dir(args.out)
     print(f"{schedule.solver}: {schedule.status}, objective {schedule.objective}, operated {schedule.operated_count}, "
           f"cancelled {schedule.cancelled}, total delay {schedule.total_delay_s:.1f} s, "
@@ -413,6 +419,9 @@ def build_parser() -> argparse.ArgumentParser:
     verify.add_argument("dir", help="folder with flights.json and schedule.csv")
     verify.set_defaults(func=cmd_verify)
     command("reproduce", cmd_reproduce, "run every stage that applies and write report.md with figures", "out/reproduce")
+    from uamopt.export.cli import add_export_commands
+
+    add_export_commands(sub)  # export bluesky | geojson, replay
     return parser
 
 
