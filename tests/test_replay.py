@@ -7,7 +7,9 @@ case; the whole paper case under three solvers is marked slow.
 
 from __future__ import annotations
 
+import contextlib
 import csv
+import io
 import json
 import shutil
 import subprocess
@@ -54,7 +56,8 @@ def _write_folder(folder: Path, template: dict, flights: list[dict]) -> None:
 def planted(paper_schedule_dir, tmp_path_factory):
     """Two pairs of the paper network's crossing tracks V1-V4 and V2-V3 (both at 120 m), timed to
     reach the crossing point together: P1/P2 at t = 200 s on the same layer, P3/P4 at t = 350 s
-    with P4 one layer (30 m) higher. Returns (folder, expected LoS onset of P1/P2, replay result)."""
+    with P4 one layer (30 m) higher. Replayed once with the CLI: returns (folder, expected LoS onset
+    of P1/P2, exit code, printed output, replay.json)."""
     template = json.loads((paper_schedule_dir / "flights.json").read_text(encoding="utf-8"))
     by_route = {f["route"]: f for f in template["flights"]}
     a, b = (np.asarray(by_route[r]["waypoints"]) for r in ("V1-V4", "V2-V3"))
@@ -76,7 +79,10 @@ def planted(paper_schedule_dir, tmp_path_factory):
     p1 = _plan_at(a, v, flights[0]["planned_departure_s"], t)
     p2 = _plan_at(b, v, flights[1]["planned_departure_s"], t)
     onset = float(t[np.argmax(np.hypot(*(p1 - p2)[:, :2].T) < zone.rpz_m)])
-    return folder, onset, replay(folder)
+    stdout = io.StringIO()
+    with contextlib.redirect_stdout(stdout):
+        code = main(["replay", str(folder)])
+    return folder, onset, code, stdout.getvalue(), json.loads((folder / "replay.json").read_text(encoding="utf-8"))
 
 
 def test_paper_case_window_replays_with_no_loss_of_separation(paper_schedule_dir, tmp_path):
@@ -110,38 +116,32 @@ def test_paper_case_window_replays_with_no_loss_of_separation(paper_schedule_dir
 
 
 def test_planted_conflict_found_with_the_right_pair_and_time(planted):
-    _, onset, result = planted
-    assert [e["flights"] for e in result.los] == [["P1", "P2"]]
-    event = result.los[0]
+    _, onset, code, printed, out = planted
+    assert [e["flights"] for e in out["los"]] == [["P1", "P2"]]
+    event = out["los"][0]
     # BlueSky's onset vs the plan's first instant within r_pz: the two flown positions may each be
     # up to e_h = 10 m off the plan, which shifts the onset by at most 2 e_h / closing speed (here
     # ~0.6 s), plus one clock step
     assert event["start_s"] == pytest.approx(onset, abs=1.0)
     assert event["closest_horizontal_m"] < 10.0 and event["closest_vertical_m"] < 1.0
     assert event["end_s"] - event["start_s"] > 1.0
-    assert not result.over_budget
+    assert out["within_budget"] is True
+    assert code == 1 and "1 losses of separation" in printed and "flights P1 and P2" in printed
 
 
 def test_verifier_conflicts_are_near_pairs_and_when_they_are_not_losses(planted):
     """Both planted pairs are conflicts for the verifier; the one 30 m apart vertically is a near
     pair but no LoS: one layer apart is in the 3×3×3 zone, yet 30 m ≥ h_pz (sim/zone.py)."""
-    folder, _, result = planted
+    folder, *_, out = planted
     problems = verify_dir(folder)
     assert any("P1 (A1)" in p and "P2 (A2)" in p for p in problems)
     assert any("P3 (A3)" in p and "P4 (A4)" in p for p in problems)
-    near = {tuple(p["flights"]): p for p in result.near_pairs}
+    near = {tuple(p["flights"]): p for p in out["near_pairs"]}
     assert set(near) == {("P1", "P2"), ("P3", "P4")}
     offset = near[("P3", "P4")]
     assert offset["los_steps"] == 0
     assert offset["min_horizontal_m"] < 10.0
     assert offset["vertical_at_min_horizontal_m"] == pytest.approx(30.0, abs=0.5)
-
-
-def test_replay_cli_exits_1_and_names_the_pair(planted, capsys):
-    folder = planted[0]
-    assert main(["replay", str(folder), "--window", "0,200"]) == 1  # P1, P2 depart before they meet at 200 s
-    out = capsys.readouterr().out
-    assert "1 losses of separation" in out and "flights P1 and P2" in out
 
 
 def test_missing_bluesky_is_one_line_exit_2(paper_schedule_dir):

@@ -117,7 +117,12 @@ def _stamp(t_s: float) -> str:
 
 
 def flight_commands(acid: str, waypoints: np.ndarray, speed_mps: float, frame, bank_deg: float) -> list[str]:
-    """CRE, BANK, ADDWPT..., AT-last-waypoint DEL, LNAV/VNAV: one aircraft flying ``waypoints`` at v_g."""
+    """CRE, BANK, ADDWPT..., AT-last-waypoint DEL, LNAV/VNAV: one aircraft flying ``waypoints`` at v_g.
+
+    Repeated points (legs of zero length) are dropped: BlueSky would fly them at zero speed.
+    """
+    keep = np.concatenate([[True], np.linalg.norm(np.diff(waypoints, axis=0), axis=1) > 1e-6])
+    waypoints = waypoints[keep]
     lon, lat = frame.to_lonlat(waypoints[:, 0], waypoints[:, 1])
     z = waypoints[:, 2]
     planned = np.linalg.norm(np.diff(waypoints, axis=0), axis=1)
