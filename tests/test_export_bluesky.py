@@ -18,8 +18,10 @@ from georef import hand_lonlat
 from pyproj import Transformer
 
 from uamopt.cli import main
+from uamopt.errors import UamoptError
 from uamopt.export.frame import scenario_frame
 from uamopt.scenario import load_scenario
+from uamopt.sim.zone import protected_zone
 
 DT = 0.05
 FT, KT = 0.3048, 1852.0 / 3600.0
@@ -105,3 +107,23 @@ def test_export_bad_input(tmp_path, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 3 and all(line.startswith("error: ") for line in err)
     assert not (tmp_path / "bluesky.scn").exists()
+
+
+def test_protected_zone_from_the_cells():
+    """r_pz = r·min(Δx, Δy) − 2e_h − 0.5 m, h_pz = r·Δz − 2e_v − 0.5 m (uamopt/sim/zone.py)."""
+    zone = protected_zone((20.0, 10.0, 8.0), 2, budget_h_m=1.0, budget_v_m=0.5)
+    assert (zone.rpz_m, zone.hpz_m) == (17.5, 14.5)
+    assert zone.near_m == (62.0, 32.0, 25.0)  # (r + 1)Δ + 2e
+    with pytest.raises(UamoptError, match=r"protected zone is empty .* give --zone"):
+        protected_zone((50.0, 50.0, 30.0), 0)  # same-cell conflicts guarantee no distance
+    assert protected_zone((50.0, 50.0, 30.0), 0, zone_m=(20.0, 10.0)).rpz_m == 20.0
+
+
+def test_docstring_examples_run():
+    import doctest
+
+    from uamopt.export import frame
+    from uamopt.sim import zone
+
+    for module in (frame, zone):
+        assert doctest.testmod(module).failed == 0

@@ -61,7 +61,7 @@ class LocalFrame:
     Examples
     --------
     >>> f = synthetic_frame()
-    >>> [round(v, 4) for v in f.to_lonlat(0.0, 0.0)]
+    >>> [round(float(v), 4) for v in f.to_lonlat(0.0, 0.0)]
     [118.77, 32.02]
     """
 
