@@ -294,12 +294,11 @@ def _scheduling_problem(scenario, args, bar):
 
 
 def cmd_schedule(args) -> int:
+    from uamopt.export.frame import schedule_provenance
     from uamopt.outputs import check_out_dir
     from uamopt.schedule import write_schedule
     from uamopt.schedule.verify import verify_dir
     from uamopt.solvers import load_profile, solve
-
-    from uamopt.export.frame import schedule_provenance
 
     scenario = _load(args)
     profile = load_profile(args.solver)

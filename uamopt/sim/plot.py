@@ -22,7 +22,7 @@ def plot_replay(result, path: str | Path) -> Path:
     ax.set_xlabel("scheduled departure (s)")
     ax.set_ylabel("m")
     ax.set_ylim(bottom=0)
-    ax.legend(fontsize=8, loc="lower right")
+    ax.legend(fontsize=8, loc="best")
     ax.set_title(f"{len(result.flights)} flights in BlueSky ({result.settings['aircraft_type']}, "
                  f"bank {result.settings['bank_deg']:g}°, dt {result.settings['dt_s']:g} s)", fontsize=10)
     bx.add_patch(Rectangle((0, 0), zone.rpz_m, zone.hpz_m, color="crimson", alpha=0.15, label="LoS zone"))
