@@ -39,3 +39,32 @@ def paper_straight_plan():
     grid = AirspaceGrid.from_extent(scenario.grid.cell, scenario.grid.extent)
     network = straight_network(scenario, grid)
     return scenario, grid, network, generate_plan(scenario, network, seed=0, max_delay_scale=1.0)
+
+
+@pytest.fixture(scope="session")
+def paper_schedule_dir(tmp_path_factory) -> Path:
+    """A schedule folder of the paper case (highs, planned network) written by ``uamopt schedule``.
+
+    Read-only for tests: copy it before changing anything in it.
+    """
+    from uamopt.cli import main
+
+    out = tmp_path_factory.mktemp("paper_schedule") / "highs"
+    assert main(["schedule", str(PAPER_CASE), "--solver", "highs", "--out", str(out)]) == 0
+    return out
+
+
+@pytest.fixture(scope="session")
+def paper_export(paper_schedule_dir, tmp_path_factory):
+    """``paper_export(kind)``: a fresh copy of ``paper_schedule_dir`` after ``uamopt export KIND``."""
+    import shutil
+
+    from uamopt.cli import main
+
+    def export(kind: str) -> Path:
+        folder = tmp_path_factory.mktemp(kind) / "highs"
+        shutil.copytree(paper_schedule_dir, folder)
+        assert main(["export", kind, str(folder)]) == 0
+        return folder
+
+    return export

@@ -72,6 +72,14 @@ def dsm_extent(scenario: "Scenario") -> tuple[float, float]:
     return right - left, top - bottom
 
 
+def dsm_frame(scenario: "Scenario") -> tuple[str, float, float]:
+    """(CRS, left, bottom): the DSM's projected CRS and the CRS coordinates of the local (0, 0), m."""
+    path = _dsm_path(scenario)
+    with _open(path, "city.dsm") as src:
+        left, bottom, _, _ = _check_frame(src, path)
+        return src.crs.to_string(), float(left), float(bottom)
+
+
 def _on_grid(src, grid: "AirspaceGrid", frame: tuple, resampling: Resampling) -> np.ndarray:
     """Band 1 of ``src`` on the grid's columns, (nx, ny) indexed [i, j] with j northward; NaN outside.
 

@@ -251,13 +251,14 @@ def _fmt(value: float) -> str:
     return repr(float(value))
 
 
-def write_schedule(out_dir: str | Path, problem: SchedulingProblem, schedule: Schedule) -> None:
+def write_schedule(out_dir: str | Path, problem: SchedulingProblem, schedule: Schedule, *, extra: dict | None = None) -> None:
     """Write flights.json, schedule.csv and summary.json into ``out_dir``, all or nothing.
 
     ``schedule.csv``: flight, aircraft, route, operated (1/0), planned_departure_s, delay_s,
     departure_s, arrival_s; a cancelled flight has delay 0 and empty departure and arrival.
     ``summary.json`` carries the INTERFACES.md keys plus ``weights``, ``objective_kind``,
-    ``aircraft`` (G) and ``flights`` so the verifier can recompute the objective.
+    ``aircraft`` (G) and ``flights`` so the verifier can recompute the objective; ``extra`` adds
+    keys (``uamopt schedule`` adds ``frame`` and ``scenario`` for the exports, uamopt.export.frame).
     """
     from uamopt.outputs import staged_output, write_json
 
@@ -267,7 +268,7 @@ def write_schedule(out_dir: str | Path, problem: SchedulingProblem, schedule: Sc
     summary = schedule.summary() | {
         "weights": list(problem.weights), "objective_kind": problem.objective_kind,
         "aircraft": problem.aircraft_count, "flights": problem.n_flights,
-    }
+    } | (extra or {})
     if schedule.extras:
         summary["extras"] = schedule.extras
     if fs.notes:
