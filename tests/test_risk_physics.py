@@ -1,4 +1,4 @@
-"""The risk model's physics against MODEL_NOTES reference numbers and known limits."""
+"""The risk model's physics against the reference numbers of docs/readings.md and known limits."""
 
 from __future__ import annotations
 
@@ -8,6 +8,8 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp, tplquad
 
+from uamopt.city.layers import CityLayers
+from uamopt.grid import AirspaceGrid
 from uamopt.risk import (
     crash_area,
     drag_constant,
@@ -16,6 +18,7 @@ from uamopt.risk import (
     impact_energy,
     impact_speed,
     mean_relative_speed,
+    risk_field,
     swept_volume,
     terminal_speed,
     vehicle_collision_probability,
@@ -75,11 +78,17 @@ def test_reference_numbers(payload):
 
 
 def test_vehicle_terms():
-    p_v = vehicle_collision_probability(9.68, 0.07, 3.5)
-    assert p_v == approx_printed("0.1936")
-    n_v = 0.07 * 50.0
-    assert n_v == approx_printed("3.5")
-    assert LAM * n_v * p_v == approx_printed("4.092704e-05")
+    """P^V (Eq. 5) and R^V = λ N^V P^V (Eq. 4) of a column with l_r = 50 m of road, through the
+    field computation: N^V = ρ_V l_r = 3.5 makes R^V = 4.092704e-05 at every altitude (reference)."""
+    assert vehicle_collision_probability(9.68, 0.07, 3.5) == approx_printed("0.1936")
+    grid = AirspaceGrid(cell=(50.0, 50.0, 30.0), shape=(2, 1, 10))
+    zeros = np.zeros((2, 1))
+    city = CityLayers(zeros, zeros, np.array([[0.0], [50.0]]), zeros + 2.5e-4, zeros + 0.5, zeros > 0, zeros > 0,
+                      source="test")
+    field = risk_field(B3, grid, city)
+    assert np.all(field.risk_V[0] == 0.0)
+    for value in field.risk_V[1, 0]:
+        assert value == approx_printed("4.092704e-05")
 
 
 @pytest.mark.parametrize("payload", [0.0, 220.0])

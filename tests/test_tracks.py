@@ -22,9 +22,8 @@ P_O, P_D = (300.0, 300.0, 120.0), (2220.0, 4220.0, 120.0)
 
 
 @pytest.fixture(scope="module")
-def model(root):
-    s = load_scenario(root / "models" / "paper_case.toml")
-    return planning_model(s, compute_risk(s).field)
+def model(paper_model):
+    return paper_model
 
 
 @pytest.fixture(scope="module")
