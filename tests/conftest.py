@@ -76,3 +76,11 @@ def calibrated_problem(paper_straight_plan):
 
     scenario, _, network, _ = paper_straight_plan
     return build_problem(paper_case_plan(scenario, network, seed=0), scenario)
+
+
+@pytest.fixture(scope="session")
+def paper_highs(paper_problem):
+    """HiGHS's proven optimum of ``paper_problem`` (a few seconds; solved once per session)."""
+    from uamopt.solvers import SolverProfile, milp
+
+    return milp.solve(paper_problem, SolverProfile("highs", time_limit_s=30.0, threads=2))

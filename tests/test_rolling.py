@@ -22,10 +22,9 @@ def profile(**options) -> SolverProfile:
 
 
 @pytest.fixture(scope="module")
-def paper_optimum(paper_problem):
-    exact = milp.solve(paper_problem, SolverProfile("highs", time_limit_s=30.0, threads=2))
-    assert exact.status == "optimal"
-    return exact.objective
+def paper_optimum(paper_highs):
+    assert paper_highs.status == "optimal"
+    return paper_highs.objective
 
 
 def test_rolling_paper_case(paper_problem, paper_optimum):
