@@ -23,7 +23,7 @@ from uamopt.planning.movingai import (
 )
 
 # The public benchmark files (N. Sturtevant's Moving AI grids; credits in tests/data/movingai/README.md)
-# ship with the tests; the shared/ folder beside the repository holds the same files.
+# ship with the tests.
 BENCHMARKS = Path(__file__).resolve().parent / "data" / "movingai"
 MAPS = ("arena.map", "maze512-32-9.map")
 SAMPLE_SIZE = 40

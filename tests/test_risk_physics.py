@@ -46,7 +46,7 @@ def k_for(payload_kg: float) -> float:
     return drag_constant(400.0 + payload_kg, 0.3, 1.225, S_E)
 
 
-# (terminal, v(148.2), t(148.2), E, P cs=0.5, P cs=0.75, R^P cs=0.5) from MODEL_NOTES
+# (terminal, v(148.2), t(148.2), E, P cs=0.5, P cs=0.75, R^P cs=0.5) from docs/readings.md (Reference numbers)
 REFERENCE = {
     0.0: ("27.468", "27.174496", "7.323078", "147690.7", "0.277616", "0.115849", "1.185261e-07"),
     220.0: ("34.198", "32.740228", "6.677222", "332296.0", "0.365664", "0.146535", "1.561174e-07"),
@@ -171,7 +171,7 @@ def test_road_threshold_and_open_ground_bound():
     e_max = float(impact_energy(620.0, terminal_speed(k, G)))
     p_max = float(fatality_probability(e_max, 0.5, 1e6, 232.0))
     people = 0.5 * LAM * 2.5e-4 * S_E * p_max
-    assert people == pytest.approx(8.02e-8, rel=5e-4)  # the bound MODEL_NOTES quotes, to its 3 digits
+    assert people == pytest.approx(8.02e-8, rel=5e-4)  # the bound docs/readings.md quotes, to its 3 digits
     t_300 = float(fall_time(300.0, k, G))
     uav = 0.2 * LAM * 3.48e-8 * 5.63 * 1.855 * (23.664 * t_300 + 5.63)
     assert people + uav < 1e-7

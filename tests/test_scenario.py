@@ -27,7 +27,7 @@ def test_defaults_are_table_b3():
     assert s.schedule.weights == (0.6, 0.4)
     ports = {v.name: (v.x, v.y) for v in s.network.vertiports}
     assert ports == {"V1": (300, 300), "V2": (300, 4220), "V3": (2220, 300), "V4": (2220, 4220), "V5": (1260, 2260)}
-    # L_14 = 4365 m is |V4 - V1| (MODEL_NOTES)
+    # L_14 = 4365 m is |V4 - V1| (docs/readings.md)
     assert math.dist(ports["V1"], ports["V4"]) == pytest.approx(4365, abs=0.5)
 
 

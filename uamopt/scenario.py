@@ -5,7 +5,7 @@ unit stand beside each field (``description``) and ``uamopt keys`` would list th
 are validated once, here, at the boundary (STYLE.md); the library trusts them afterwards.
 
 Reading: ``load_scenario(path, overrides=["grid.cell=[10,10,10]"])``. Overrides use TOML value
-syntax with dotted keys (INTERFACES.md); a value that is not valid TOML is taken as a string, so
+syntax with dotted keys (docs/interfaces.md); a value that is not valid TOML is taken as a string, so
 ``--set city.source=osm`` works without quotes.
 """
 
@@ -73,7 +73,7 @@ class AircraftConfig(_Section):
     payload_kg: NonNegFloat = Field(
         145.6,
         description="m_p, kg. Table B.3 gives no value; 145.6 kg reproduces Table 2's shortest-track "
-        "cost of ¥27.15 over 4365 m through Eqs. 12-13 (MODEL_NOTES)",
+        "cost of ¥27.15 over 4365 m through Eqs. 12-13 (docs/readings.md)",
     )
     payload_max_kg: PositiveFloat = Field(220.0, description="m_p max, kg")
     mass_max_kg: PositiveFloat = Field(650.0, description="m_max, maximum take-off mass, kg (Eq. 18)")
@@ -134,7 +134,7 @@ class Vertiport(_Section):
 
 
 def _paper_vertiports() -> tuple[Vertiport, ...]:
-    # Table B.3 gives V1..V5 in 10 m grid units (MODEL_NOTES): V1 = (30, 30) is (300 m, 300 m).
+    # Table B.3 gives V1..V5 in 10 m grid units (docs/readings.md): V1 = (30, 30) is (300 m, 300 m).
     pts = {"V1": (30, 30), "V2": (30, 422), "V3": (222, 30), "V4": (222, 422), "V5": (126, 226)}
     return tuple(Vertiport(name=n, x=10.0 * x, y=10.0 * y) for n, (x, y) in pts.items())
 
@@ -174,7 +174,7 @@ class TracksConfig(_Section):
     clearance_m: NonNegFloat = Field(50.0, description="s_min, building clearance, m (Eq. 15)")
     buffer_penalty: NonNegFloat = Field(100.0, description="μ, safety-buffer shell penalty (Eq. 35)")
     buffer_measure: Literal["count", "share"] = Field(
-        "count", description="R(t) of Eq. 35: the number of unsafe cells on the buffer's outer shell (MODEL_NOTES), "
+        "count", description="R(t) of Eq. 35: the number of unsafe cells on the buffer's outer shell (docs/readings.md), "
         "or their share of the shell's cells (a variant that does not grow with finer cells)"
     )
     risk_model: Literal["binary", "continuous"] = Field("binary", description="Eq. 9 field or Eq. 8 field")
@@ -234,7 +234,7 @@ class ScheduleConfig(_Section):
 
 
 class Scenario(_Section):
-    """A whole scenario: one TOML file, sections as in INTERFACES.md."""
+    """A whole scenario: one TOML file, sections as in docs/interfaces.md."""
 
     name: str = "scenario"
     description: str = ""
