@@ -50,7 +50,7 @@ def test_solve_by_name_uses_the_shipped_profile(paper_straight_plan):
     """``solve(problem, "rolling")`` reads solvers/rolling.toml (900 s windows, CP-SAT inside). On 6
     aircraft (36 flights) its windows cost it against the whole-day optimum, and its bound is valid."""
     scenario, _, network, _ = paper_straight_plan
-    problem = build_problem(generate_plan(scenario, network, seed=0, aircraft=6), scenario)
+    problem = build_problem(generate_plan(scenario, network, seed=0, aircraft=6, max_delay_scale=1.0), scenario)
     s = solve(problem, "rolling")
     exact = milp.solve(problem, SolverProfile("highs", time_limit_s=30.0, threads=2))
     assert s.solver == "rolling" and s.extras["windows"] == 4 and exact.status == "optimal"
