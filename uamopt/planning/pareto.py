@@ -194,8 +194,9 @@ def pareto_front(model: PlanningModel, origin, destination, weights: int | Seque
     >>> front = pareto_front(model, (300, 300, 120), (2220, 4220, 120), 5, buffer=False)
     >>> [(round(p.risk_cost), round(p.transport_cost, 2)) for p in front]
     [(3068, 29.15), (2985, 29.52), (2902, 30.25), (2861, 30.61), (2744, 97.11)]
-    >>> len(pareto_front(model, (300, 300, 120), (2220, 4220, 120), 5))  # μ·R(t) dominates: one point
-    1
+    >>> with_buffer = pareto_front(model, (300, 300, 120), (2220, 4220, 120), 5)  # plus μ·R(t), Eq. 34
+    >>> [(round(p.risk_cost), round(p.transport_cost, 2)) for p in with_buffer]
+    [(3206, 99.08), (3002, 99.81), (2961, 100.18)]
     """
     return non_dominated(weight_sweep(model, origin, destination, weights, buffer=buffer))
 
