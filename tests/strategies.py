@@ -39,7 +39,9 @@ def tiny_problems(draw, max_flights: int = 6):
                 speed = draw(st.sampled_from([5.0, 10.0]))
             else:
                 start = [draw(num(0, 60)), draw(num(0, 60)), draw(num(0, 15))]
-                ends = [start, [60.0 - start[0] + draw(num(-10, 10)), 60.0 - start[1] + draw(num(-10, 10)), draw(num(0, 15))]]
+                # the far end near the mirror point, kept in the local frame (x, y ≥ 0, as the verifier requires)
+                ends = [start, [max(0.0, 60.0 - start[0] + draw(num(-10, 10))), max(0.0, 60.0 - start[1] + draw(num(-10, 10))),
+                                draw(num(0, 15))]]
                 speed = draw(num(4, 12))
             waypoints = np.array(ends)
             if np.linalg.norm(waypoints[1] - waypoints[0]) < 1.0:
