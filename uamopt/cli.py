@@ -1,4 +1,4 @@
-"""Command line: ``uamopt COMMAND SCENARIO [--set KEY=VALUE ...] [--out DIR]`` (INTERFACES.md).
+"""Command line: ``uamopt COMMAND SCENARIO [--set KEY=VALUE ...] [--out DIR]`` (docs/interfaces.md).
 
 Bad input ends with one line ``error: <what> (<where>): <how to fix>`` on stderr and exit code 2;
 results are staged and moved into ``--out`` only when complete.
