@@ -40,3 +40,12 @@ __all__ = [
     "risk_field",
 ]
 __version__ = "0.1.0"
+
+
+def __getattr__(name: str):
+    """``uamopt.plotting`` on first use: the figures import matplotlib, the rest of uamopt does not."""
+    if name == "plotting":
+        import importlib
+
+        return importlib.import_module("uamopt.plotting")
+    raise AttributeError(f"module 'uamopt' has no attribute {name!r}")

@@ -51,6 +51,7 @@ from uamopt.plotting.style import (
     is_tall,
     layer_of,
     log10,
+    log_axis,
     map_axes,
     mark_threshold,
     outline,
@@ -200,7 +201,7 @@ def _panel_profiles(ax, field) -> None:
         label, colour = PROFILE_STYLE[name]
         ax.plot(_positive(values), z, color=colour, lw=1.6 if name == "risk" else 1.1,
                 label=label, marker=".", ms=3)
-    ax.set_xscale("log")
+    log_axis(ax)
     ax.axvline(field.threshold, color="0.45", lw=1.0, ls="--", label="R₀")
     ax.axhspan(*field.band, color=BAND_GREEN, alpha=0.08, lw=0, label="altitude band")
     ax.set_ylim(0.0, field.grid.extent[2])
@@ -351,7 +352,7 @@ def risk_components(field, ax=None, *, title: str = "") -> Figure:
         axis.fill_betweenx(z, _positive(lo), _positive(hi), color=colour, alpha=0.2, lw=0,
                            label="10–90 % (term > 0)")
         axis.plot(_positive(means[name]), z, color=colour, lw=1.5, marker=".", label="mean")
-        axis.set_xscale("log")
+        log_axis(axis)
         axis.axvline(field.threshold, color=NO_FLY, lw=1.0, ls="--", label="R₀")
         axis.axhspan(*field.band, color=BAND_GREEN, alpha=0.08, lw=0)
         share = (values > 0).sum() / max(int(free.sum()), 1)
