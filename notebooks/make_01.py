@@ -17,16 +17,14 @@ Executed by `tests/test_notebooks.py`: every `assert` below is a check, so a cle
 numbers hold. Run it with the repository root (or `notebooks/`) as the working directory."""),
     code("""from pathlib import Path
 import math
-import tempfile
 from decimal import Decimal
 
 import numpy as np
 import pandas as pd
-from IPython.display import Image, display
 from scipy.integrate import solve_ivp
 
+import uamopt.plotting as plotting
 from uamopt import build_grid, load_city, load_scenario, risk_field
-from uamopt.plots import plot_risk
 from uamopt.risk import (crash_area, drag_constant, fall_time, fatality_probability, impact_energy,
                          impact_speed, mean_relative_speed, vehicle_collision_probability)
 
@@ -141,16 +139,17 @@ print(f"m_p = {a.payload_kg} kg: A.3 {float(impact_speed(height, k, g)):.8f} m/s
       f"fall time {float(fall_time(height, k, g)):.8f} s, ODE {t_ode:.8f} s")"""),
     md("""## 3 · The risk map
 
-`uamopt.plots.plot_risk` (the `risk.png` of `uamopt risk`) draws (a) $\\log_{10} R$ (Eq. 8) on the
+`uamopt.plotting.risk` (the `risk.png` of `uamopt risk`) returns a matplotlib Figure, shown
+below; `plotting.save(fig, "risk.png")` writes it, and `plotting.risk(field, ax=ax)` draws map (a)
+alone into axes of your own. The page shows (a) $\\log_{10} R$ (Eq. 8) on the
 layer holding the 120 m cruise altitude — the colours jump from blue to yellow at $R_0$, so the
 binary field of Eq. 9 reads directly; buildings reaching the layer are dark grey, no-fly zones
 hatched red; (b) the city: building heights, roads, parks and water; (c) an x–z section through
 V5 with the unsafe free cells outlined and the altitude band of Eq. 14; (d) the mean of each risk
 term per layer; (e) the unsafe share per layer."""),
-    code("""out = Path(tempfile.mkdtemp(prefix="uamopt-nb01-"))
-png = plot_risk(field, out / "risk.png", vertiports=scenario.network.vertiports,
-                cruise_altitude_m=scenario.network.cruise_altitude_m, title=scenario.name)
-display(Image(filename=str(png)))"""),
+    code("""fig = plotting.risk(field, vertiports=scenario.network.vertiports,
+                    cruise_altitude_m=scenario.network.cruise_altitude_m, title=scenario.name)
+fig"""),
     md("""## 4 · Unsafe cells per altitude layer
 
 Eq. 9 marks a cell unsafe for three reasons: it lies inside or below a building (obstacle), in a
@@ -200,6 +199,6 @@ nb = new_notebook(cells=cells, metadata={
     "language_info": {"name": "python"},
 })
 nbformat.validate(nb)
-target = Path("/work/main/notebooks/01_risk_field.ipynb")
+target = Path(__file__).resolve().parent / "01_risk_field.ipynb"
 nbformat.write(nb, target)
 print("wrote", target)

@@ -1,4 +1,4 @@
-"""The scheduling figures (uamopt/plot_schedule.py), read back from the SVG they write: the bars,
+"""The scheduling figures (uamopt/plotting/schedule.py), read back from the SVG they write: the bars,
 their positions and lengths must be the schedule's departures, flight times and delays."""
 
 from __future__ import annotations
@@ -10,7 +10,15 @@ import numpy as np
 import pytest
 from instances import crossing_problem
 
-from uamopt.plot_schedule import plot_delay_comparison, plot_gantt
+from uamopt import plotting
+
+
+def plot_gantt(problem, schedule, path):
+    return plotting.save(plotting.gantt(problem, schedule), path)
+
+
+def plot_delay_comparison(problem, schedules, path):
+    return plotting.save(plotting.delays(problem, schedules), path)
 from uamopt.solvers import SolverProfile, solve
 
 SVG = "{http://www.w3.org/2000/svg}"

@@ -41,8 +41,8 @@ def _load(args):
 
 def _risk_stage(scenario, stage: Path, bar) -> dict:
     """Compute the risk field and write risk.npz, risk.png, summary.json into ``stage``."""
+    from uamopt import plotting
     from uamopt.outputs import write_json
-    from uamopt.plots import plot_risk
     from uamopt.stages import compute_risk, risk_summary
 
     bar.set_description("risk field")
@@ -50,10 +50,10 @@ def _risk_stage(scenario, stage: Path, bar) -> dict:
     bar.update(1)
     run.field.save_npz(stage / "risk.npz")
     bar.set_description("risk map")
-    plot_risk(
-        run.field, stage / "risk.png", vertiports=scenario.network.vertiports,
+    plotting.save(plotting.risk(
+        run.field, vertiports=scenario.network.vertiports,
         cruise_altitude_m=scenario.network.cruise_altitude_m, title=scenario.name,
-    )
+    ), stage / "risk.png")
     bar.update(1)
     summary = risk_summary(run)
     write_json(stage / "summary.json", summary)
@@ -87,9 +87,9 @@ def _planning(scenario, bar):
 
 def _plan_stage(scenario, model, origin, destination, stage: Path, bar) -> dict:
     """Plan the four stages and write tracks.json and tracks.png into ``stage``."""
+    from uamopt import plotting
     from uamopt.outputs import write_json
     from uamopt.planning import plan_track
-    from uamopt.plot_tracks import plot_tracks
 
     bar.set_description("tracks")
     plan = plan_track(model, origin, destination)
@@ -97,21 +97,22 @@ def _plan_stage(scenario, model, origin, destination, stage: Path, bar) -> dict:
     doc = {**plan.as_dict(), "scenario": {"name": scenario.name, "file": scenario.source,
                                           "cell": list(model.field.grid.cell), "weights": list(scenario.tracks.weights)}}
     write_json(stage / "tracks.json", doc)
-    plot_tracks(model, plan, stage / "tracks.png", title=scenario.name)
+    plotting.save(plotting.tracks(plan, model, title=scenario.name), stage / "tracks.png")
     bar.update(1)
     return doc
 
 
 def _network_stage(scenario, model, stage: Path, bar):
     """Plan every route in both directions and write network.json and network.png."""
+    from uamopt import plotting
     from uamopt.outputs import write_json
     from uamopt.planning.network import plan_network
-    from uamopt.plot_tracks import plot_network
 
     bar.set_description("network")
     network = plan_network(model, progress=bar)
     write_json(stage / "network.json", network.to_document())
-    plot_network(model, network.waypoints(), stage / "network.png", vertiports=scenario.network.vertiports)
+    plotting.save(plotting.network(model, network.waypoints(), vertiports=scenario.network.vertiports),
+                  stage / "network.png")
     return network
 
 
@@ -175,7 +176,7 @@ REPRODUCE_SOLVERS = ("greedy", "ga", "soa", "highs", "cpsat")
 
 def _reproduce_schedules(scenario, model, network, stage: Path, bar, provenance: dict | None = None) -> list[str]:
     """Table 3 / Fig. 19: every solver profile on the paper-case plan over the planned network."""
-    from uamopt.plot_schedule import plot_delay_comparison, plot_gantt
+    from uamopt import plotting
     from uamopt.report import is_paper_schedule, table3_section
     from uamopt.schedule import build_problem, write_schedule
     from uamopt.schedule.verify import verify_dir
@@ -195,8 +196,8 @@ def _reproduce_schedules(scenario, model, network, stage: Path, bar, provenance:
             bar.update(1)
         suffix = "" if objective == scenario.schedule.objective else f"_{objective}"
         best = min((s for s in schedules.values() if s.objective is not None), key=lambda s: s.objective)
-        plot_gantt(problem, best, stage / f"gantt{suffix}.png")
-        plot_delay_comparison(problem, schedules, stage / f"delays{suffix}.png")
+        plotting.save(plotting.gantt(problem, best), stage / f"gantt{suffix}.png")
+        plotting.save(plotting.delays(problem, schedules), stage / f"delays{suffix}.png")
         sections.append(table3_section(problem, schedules, verified, suffix=suffix,
                                        paper=is_paper_schedule(scenario, problem)))
     return sections
@@ -206,8 +207,8 @@ def cmd_reproduce(args) -> int:
     from uamopt.outputs import check_out_dir, staged_output, write_json
     from uamopt.planning import planning_model
     from uamopt.planning.endpoints import default_endpoints, is_paper_track
-    from uamopt.plot_tracks import plot_tracks
-    from uamopt.planning.pareto import plot_pareto, weight_sweep
+    from uamopt import plotting
+    from uamopt.planning.pareto import weight_sweep
     from uamopt.report import (network_section, pareto_section, risk_section, table2_section, table4_section,
                                write_report)
 
@@ -230,7 +231,7 @@ def cmd_reproduce(args) -> int:
         tracks = {**plan.as_dict(), "scenario": {"name": scenario.name, "file": scenario.source,
                                                  "cell": list(fine_model.field.grid.cell)}}
         write_json(stage / "tracks.json", tracks)
-        plot_tracks(fine_model, plan, stage / "tracks.png", title=f"{scenario.name}, {t2:g} m cells")
+        plotting.save(plotting.tracks(plan, fine_model, title=f"{scenario.name}, {t2:g} m cells"), stage / "tracks.png")
         table4 = [(side, plans[side][2], plans[side][3]) for side in scenario.tracks.table4_cells]
         bar.set_description("buffer variant")
         other = "count" if scenario.tracks.buffer_measure != "count" else "structures"
@@ -239,7 +240,8 @@ def cmd_reproduce(args) -> int:
         v_tracks = {**v_plan.as_dict()}
         bar.set_description("pareto front")
         fronts = {flag: weight_sweep(fine_model, origin, destination, 9, buffer=flag) for flag in (False, True)}
-        plot_pareto(fronts[True], stage / "pareto.png", title=f"{scenario.name}: Eq. 10 + μ·R(t) trade-off")
+        plotting.save(plotting.pareto(fronts[True], title=f"{scenario.name}: Eq. 10 + μ·R(t) trade-off"),
+                      stage / "pareto.png")
         from uamopt.export.frame import schedule_provenance
 
         sched_sections = _reproduce_schedules(scenario, model, network, stage, bar, schedule_provenance(scenario, args.set))
