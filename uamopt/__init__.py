@@ -22,6 +22,7 @@ from uamopt.scenario import Scenario, load_scenario
 from uamopt.grid import AirspaceGrid, build_grid
 from uamopt.city import CityLayers, load_city
 from uamopt.risk import RiskField, risk_field
+from uamopt.experiments import sweep
 
 __all__ = [
     "AirspaceGrid",
@@ -38,5 +39,6 @@ __all__ = [
     "load_city",
     "load_scenario",
     "risk_field",
+    "sweep",
 ]
 __version__ = "0.1.0"

@@ -413,6 +413,9 @@ def build_parser() -> argparse.ArgumentParser:
     verify.add_argument("dir", help="folder with flights.json and schedule.csv")
     verify.set_defaults(func=cmd_verify)
     command("reproduce", cmd_reproduce, "run every stage that applies and write report.md with figures", "out/reproduce")
+    from uamopt.experiments.engine import add_sweep_command
+
+    add_sweep_command(sub)
     return parser
 
 
