@@ -192,12 +192,7 @@ def test_schedule_verify_and_bench(tmp_path):
     (out / "schedule.csv").write_text("\n".join([lines[0]] + [",".join(r) for r in rows]) + "\n")
     bad = run("verify", str(out))
     assert bad.returncode == 1 and bad.stdout.strip()
-    bench = tmp_path / "bench"
-    proc = run("bench", PAPER, "--solver", "greedy", "cpsat", "--out", str(bench))
-    assert proc.returncode == 0, proc.stderr
-    csv_rows = (bench / "bench.csv").read_text().splitlines()
-    assert len(csv_rows) == 3 and csv_rows[1].endswith("yes") and csv_rows[2].endswith("yes")
-    assert (bench / "bench.md").exists()
+    # `uamopt bench`: tests/test_benchmark.py
 
 
 def test_schedule_bad_input(tmp_path):

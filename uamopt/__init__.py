@@ -22,7 +22,7 @@ from uamopt.scenario import Scenario, load_scenario
 from uamopt.grid import AirspaceGrid, build_grid
 from uamopt.city import CityLayers, load_city
 from uamopt.risk import RiskField, risk_field
-from uamopt.experiments import sweep
+from uamopt.experiments import benchmark, sweep
 
 __all__ = [
     "AirspaceGrid",
@@ -35,6 +35,7 @@ __all__ = [
     "Scenario",
     "ScenarioError",
     "UamoptError",
+    "benchmark",
     "build_grid",
     "load_city",
     "load_scenario",

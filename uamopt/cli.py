@@ -330,45 +330,9 @@ def cmd_verify(args) -> int:
 
 
 def cmd_bench(args) -> int:
-    import tempfile
+    from uamopt.experiments.benchmark import cmd_bench as bench
 
-    from uamopt.outputs import check_out_dir, staged_output
-    from uamopt.scenario import load_scenario
-    from uamopt.schedule import write_schedule
-    from uamopt.schedule.verify import verify_dir
-    from uamopt.solvers import load_profile, solve
-
-    profiles = [load_profile(p) for p in args.solver]
-    scenarios = [load_scenario(path, args.set) for path in args.scenario]
-    check_out_dir(args.out)
-    rows = []
-    with _progress(len(scenarios) * (2 + len(profiles)), "bench") as bar:
-        for scenario in scenarios:
-            problem = _scheduling_problem(scenario, args, bar)
-            for profile in profiles:
-                bar.set_description(f"{scenario.name}: {profile.name}")
-                schedule = solve(problem, profile)
-                with tempfile.TemporaryDirectory() as tmp:
-                    write_schedule(Path(tmp) / "s", problem, schedule)
-                    verified = not verify_dir(Path(tmp) / "s")
-                rows.append({"instance": scenario.name, "flights": problem.n_flights, "profile": profile.name,
-                             "solver": profile.solver, "status": schedule.status, "objective": schedule.objective,
-                             "bound": schedule.bound, "gap": schedule.gap, "operated": schedule.operated_count,
-                             "cancelled": schedule.cancelled, "total_delay_s": schedule.total_delay_s,
-                             "seconds": schedule.solve_seconds, "verified": "yes" if verified else "NO"})
-                bar.update(1)
-    keys = list(rows[0])
-    with staged_output(args.out) as stage:
-        with open(stage / "bench.csv", "w", encoding="utf-8") as fh:
-            fh.write(",".join(keys) + "\n")
-            for r in rows:
-                fh.write(",".join("" if r[k] is None else str(r[k]) for k in keys) + "\n")
-        fmt = lambda v: "-" if v is None else (f"{v:.6g}" if isinstance(v, float) else str(v))
-        lines = ["| " + " | ".join(keys) + " |", "|" + "---|" * len(keys)]
-        lines += ["| " + " | ".join(fmt(r[k]) for k in keys) + " |" for r in rows]
-        (stage / "bench.md").write_text("\n".join(lines) + "\n", encoding="utf-8")
-    print("\n".join(lines))
-    return 0 if all(r["verified"] == "yes" for r in rows) else 1
+    return bench(args)
 
 
 def _toml_list(values) -> str:
@@ -398,11 +362,14 @@ def build_parser() -> argparse.ArgumentParser:
     for p in (sched,):
         p.add_argument("--solver", required=True, metavar="PROFILE", help="solver profile: solvers/NAME.toml or NAME")
     bench = sub.add_parser("bench", help="benchmark solver profiles on scenarios: bench.csv, bench.md",
-                           description="benchmark solver profiles on scenarios: bench.csv, bench.md")
+                           description="benchmark solver profiles × seeds on scenarios: bench.csv, bench.md")
     bench.add_argument("scenario", nargs="+", help="scenario TOML files")
     bench.add_argument("--solver", nargs="+", required=True, metavar="PROFILE", help="solver profiles")
     bench.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="override keys of every scenario")
     bench.add_argument("--out", default="out/bench", help="output folder (default: out/bench)")
+    bench.add_argument("--seeds", nargs="+", type=int, metavar="SEED",
+                       help="solver seeds: a count (--seeds 3 = 0 1 2) or a list (--seeds 0 1 2); default each profile's")
+    bench.add_argument("--time-limit", type=float, metavar="SECONDS", help="time limit of every solver (default: each profile's)")
     bench.set_defaults(func=cmd_bench)
     for p in (sched, bench):
         p.add_argument("--flights", help="flights.json to schedule instead of the generated plan")

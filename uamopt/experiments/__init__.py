@@ -6,8 +6,9 @@
 inside the functions, so importing this package is cheap.
 """
 
+from uamopt.experiments.benchmark import benchmark
 from uamopt.experiments.case import run_case
 from uamopt.experiments.engine import sweep
 from uamopt.experiments.spec import SweepSpec, load_sweep
 
-__all__ = ["SweepSpec", "load_sweep", "run_case", "sweep"]
+__all__ = ["SweepSpec", "benchmark", "load_sweep", "run_case", "sweep"]
