@@ -251,6 +251,14 @@ def load_sweep(path: str | Path, small: bool = False) -> SweepSpec:
             raise ScenarioError(f"[grid] \"{key}\" repeats a value", where, "list each value once")
         if key in fixed:
             raise ScenarioError(f"'{key}' is both in [set] and in [grid]", where, "keep it in one of them")
+    figure = raw.get("figure")
+    if figure is not None:
+        from uamopt.experiments.figures import KEYS
+
+        if figure not in KEYS:
+            raise ScenarioError(f"unknown figure {figure!r}", where, f"use one of {', '.join(KEYS)}, or remove it")
+        if KEYS[figure] not in grid:
+            raise ScenarioError(f"figure {figure!r} needs \"{KEYS[figure]}\" in [grid]", where, "sweep that key or remove it")
     fixed_overrides = [f"{k}={toml_value(v)}" for k, v in fixed.items()]
     for key, value in fixed.items():  # name the faulty key before trying combinations
         _scenario(base, [f"{key}={toml_value(value)}"], f"{where} [set] \"{key}\"")
@@ -263,4 +271,4 @@ def load_sweep(path: str | Path, small: bool = False) -> SweepSpec:
         shown = ", ".join(f"{k} = {toml_value(v)}" for k, v in values.items())
         cases.append(Case(index, case_id(overrides), values, overrides, _scenario(base, list(overrides), f"{where} case {shown}")))
     return SweepSpec(path=path, name=str(raw.get("name", path.stem)), base=base, stage=stage, solvers=solvers, seeds=seeds,
-                     fixed=fixed, grid=grid, cases=tuple(cases), time_limit_s=time_limit, figure=raw.get("figure"), small=small)
+                     fixed=fixed, grid=grid, cases=tuple(cases), time_limit_s=time_limit, figure=figure, small=small)
