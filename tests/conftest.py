@@ -29,7 +29,8 @@ def paper_run():
 
 @pytest.fixture(scope="session")
 def paper_straight_plan():
-    """(scenario, grid, straight network, generated plan) of the paper case, seed 0."""
+    """(scenario, grid, straight network, generated plan) of the paper case, seed 0, with Eq. 29
+    taken with equality (max_delay_scale = 1, not the calibrated 0.3)."""
     from uamopt.grid import AirspaceGrid
     from uamopt.scenario import load_scenario
     from uamopt.schedule import generate_plan, straight_network
@@ -37,4 +38,4 @@ def paper_straight_plan():
     scenario = load_scenario(PAPER_CASE)
     grid = AirspaceGrid.from_extent(scenario.grid.cell, scenario.grid.extent)
     network = straight_network(scenario, grid)
-    return scenario, grid, network, generate_plan(scenario, network, seed=0)
+    return scenario, grid, network, generate_plan(scenario, network, seed=0, max_delay_scale=1.0)

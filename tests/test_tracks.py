@@ -12,7 +12,7 @@ from scipy.spatial import cKDTree
 from uamopt.errors import UamoptError
 from uamopt.geometry import polyline_pieces
 from uamopt.planning import plan_track, planning_model
-from uamopt.planning.network import load_network, network_document, plan_network
+from uamopt.planning.network import load_network, plan_network
 from uamopt.planning.problem import SHORTEST_TIE_BREAK, buffer_cells, buffer_shell_count, box_counts, load_factor, transport_rates
 from uamopt.planning.tracks import corner_fillets, exact_equivalent_track, midpoint_track
 from uamopt.scenario import Scenario, load_scenario
@@ -168,17 +168,24 @@ def test_aircraft_limits(root):
 def test_network_directions_on_separate_layers(model, tmp_path):
     network = plan_network(model)
     assert len(network) == 20
-    layers = {name: k for name, (_, _, _, k) in network.items()}
-    assert layers["V1-V4"] != layers["V4-V1"]
-    for name, (o, d, p, k) in network.items():
-        cells, _, _ = polyline_pieces(p.stages["optimal"].waypoints, model.field.grid.cell)
-        assert np.all(cells[:, 2] == k), name
-    doc = network_document(model, network)
+    assert network["V1-V4"].layer_k != network["V4-V1"].layer_k
+    for name, route in network.routes.items():
+        cells, _, _ = polyline_pieces(route.waypoints, model.field.grid.cell)
+        assert np.all(cells[:, 2] == route.layer_k), name
+        np.testing.assert_array_equal(route.waypoints, route.plan.stages["optimal"].waypoints)
     import json
     path = tmp_path / "network.json"
-    path.write_text(json.dumps(doc))
+    path.write_text(json.dumps(network.to_document()))
     loaded = load_network(path)
-    assert set(loaded) == set(network) and loaded["V1-V4"].shape[1] == 3
+    assert set(loaded.routes) == set(network.routes)
+    for name, route in network.routes.items():
+        back = loaded[name]
+        np.testing.assert_array_equal(back.waypoints, route.waypoints)
+        assert (back.origin, back.destination, back.layer_k, back.length_m, back.transport_cost) == \
+            (route.origin, route.destination, route.layer_k, route.length_m, route.transport_cost)
+    frame = network.to_frame()
+    assert len(frame) == 20 and frame.loc["V1-V4", "origin"] == "V1"
+    assert frame.loc["V1-V4", "length_m"] >= 4365.0  # no track is shorter than the straight line
 
 
 def test_share_variant_gives_table2_shape(root):

@@ -173,16 +173,26 @@ class TracksConfig(_Section):
     weights: tuple[NonNegFloat, NonNegFloat] = Field((0.5, 0.5), description="(ω4, ω5) risk and transport (Eq. 10)")
     clearance_m: NonNegFloat = Field(50.0, description="s_min, building clearance, m (Eq. 15)")
     buffer_penalty: NonNegFloat = Field(100.0, description="μ, safety-buffer shell penalty (Eq. 35)")
-    buffer_measure: Literal["count", "share"] = Field(
-        "count", description="R(t) of Eq. 35: the number of unsafe cells on the buffer's outer shell (MODEL_NOTES), "
-        "or their share of the shell's cells (a variant that does not grow with finer cells)"
+    buffer_measure: Literal["structures", "count", "share"] = Field(
+        "structures", description="R(t) of Eq. 35: the obstacle and no-fly cells on the buffer's outer shell "
+        "(proximity to structures, default; docs/readings.md), or the number of unsafe (Eq. 9) cells on it "
+        "('count', the first reading), or their share of the shell's cells ('share')"
+    )
+    buffer_charge: Literal["path", "priority"] = Field(
+        "path", description="where μ·R(t) is charged: on the path cost, per cell entered (Eq. 34, default), or only "
+        "in the node priority φ′ of Eq. 34, not carried along the path ('priority')"
     )
     risk_model: Literal["binary", "continuous"] = Field("binary", description="Eq. 9 field or Eq. 8 field")
-    origin: tuple[float, float, float] = Field(
-        (300.0, 300.0, 120.0), description="P_O, default origin of `uamopt plan`, m (Table B.3: (30, 30, 120) in 10 m units)"
+    route: tuple[str, str] | None = Field(
+        None, description="the two vertiports (names) of the single-track comparison (Table 2, Table 4, Fig. 21) "
+        "and the default of `uamopt plan`, flown at network.cruise_altitude_m; omitted: the first vertiport and the "
+        "one farthest from it (V1 -> V4 = P_O -> P_D of Table B.3 in the paper case)"
     )
-    destination: tuple[float, float, float] = Field(
-        (2220.0, 4220.0, 120.0), description="P_D, default destination of `uamopt plan`, m (Table B.3: (222, 422, 120))"
+    origin: tuple[float, float, float] | None = Field(
+        None, description="P_O as x, y, z in metres, overriding tracks.route's first vertiport"
+    )
+    destination: tuple[float, float, float] | None = Field(
+        None, description="P_D as x, y, z in metres, overriding tracks.route's second vertiport"
     )
     table2_cell_m: PositiveFloat = Field(
         10.0, description="cell side (m) of the Table 2 comparison in `uamopt reproduce` (the paper's Table 2 is "
@@ -216,15 +226,21 @@ class ScheduleConfig(_Section):
     return_gap_s: NonNegFloat = Field(360.0, description="T_R, s (Eq. 28)")
     interference: NonNegFloat = Field(0.3, description="χ, interference degree coefficient (Eq. 23)")
     aircraft: Annotated[int, Field(ge=1)] = Field(20, description="G, number of eVTOLs")
-    flights: Annotated[int, Field(ge=1)] = Field(120, description="f, planned flights")
-    time_step_s: PositiveFloat = Field(10.0, description="ΔT_a, s (Table B.3)")
+    flights: Annotated[int, Field(ge=1, strict=True)] | None = Field(
+        None, description="total planned flights; ⌊flights/G⌋ per aircraft, the remainder one each over the first "
+        "aircraft. Omitted: F per aircraft from Eq. 23 (20 × 6 = 120 in the paper case). Set it to hold the number "
+        "of flights fixed while speed or the service window vary (the paper's Figs. 22-23)"
+    )
+    time_step_s: PositiveFloat = Field(
+        10.0, description="ΔT_a, s (Table B.3): the heuristics' delay grid and the grid of generated first departures"
+    )
     conflict_radius: Annotated[int, Field(ge=0)] = Field(1, description="r: conflict zone of (2r+1)³ cells")
     service_s: PositiveFloat = Field(3600.0, description="T_f − T_s, the service window, s (Eq. 23: gives F = 6)")
     first_departure_window_s: NonNegFloat = Field(
-        600.0, description="first planned departures of the aircraft are drawn in [T_s, T_s + window], s"
+        600.0, description="first planned departures of the aircraft are drawn in [T_s, T_s + window], s; an "
+        "aircraft whose flights leave less slack before T_f draws from that slack (noted in summary.json)"
     )
     plan_seed: int = Field(0, description="seed of the initial flight plan generator")
-    departure_step_s: PositiveFloat = Field(1.0, description="grid of the generated first departures, s")
     max_delay_scale: Annotated[float, Field(gt=0, le=1)] = Field(
         1.0, description="Δd as a share of Eq. 29's bound round(L/v_g) + ΔT (Eq. 29 allows any Δd up to it)"
     )

@@ -20,7 +20,7 @@ import time
 from pathlib import Path
 
 from uamopt.errors import UamoptError
-from uamopt.experiments.case import error_line, network_routes, schedule_row, scheduling_problem
+from uamopt.experiments.case import error_line, schedule_row, scheduling_problem
 from uamopt.experiments.progress import Progress
 
 COLUMNS = ["instance", "flights", "aircraft", "conflicting_pairs", "solver", "profile", "seed", "threads", "time_limit_s",
@@ -36,11 +36,9 @@ def instance_name(scenario, overrides=()) -> str:
 def scenario_problem(scenario, seed: int = 0):
     """The scenario's scheduling instance: its route network planned (Sec. 6.2) and its generated
     flight plan (plan seed ``schedule.plan_seed + seed``)."""
-    from uamopt.planning import planning_model
-    from uamopt.stages import compute_risk
+    from uamopt.pipeline import compute_risk, plan_network, planning_model
 
-    network, _ = network_routes(planning_model(scenario, compute_risk(scenario).field))
-    return scheduling_problem(scenario, network, seed)
+    return scheduling_problem(scenario, plan_network(planning_model(scenario, compute_risk(scenario))), seed)
 
 
 def _instances(problem_or_scenarios) -> dict:
@@ -73,7 +71,8 @@ def _instances(problem_or_scenarios) -> dict:
 def _profiles(solvers, time_limit_s):
     from uamopt.solvers import SolverProfile, load_profile
 
-    profiles = [s if isinstance(s, SolverProfile) else load_profile(s) for s in ([solvers] if isinstance(solvers, (str, Path)) else solvers)]
+    profiles = [s if isinstance(s, SolverProfile) else load_profile(s)
+                for s in ([solvers] if isinstance(solvers, (str, Path)) else solvers)]
     if time_limit_s is not None:
         if not (isinstance(time_limit_s, (int, float)) and math.isfinite(time_limit_s) and time_limit_s > 0):
             raise UamoptError(f"the time limit must be a positive number of seconds, got {time_limit_s!r}", "--time-limit",
@@ -84,7 +83,7 @@ def _profiles(solvers, time_limit_s):
 
 def solve_row(name: str, problem, profile, seed: int) -> dict:
     """One benchmark row: solve, time, verify; a solver failure is an ``error`` row."""
-    from uamopt.solvers import solve
+    from uamopt.pipeline import solve
 
     row = {"instance": name, "flights": problem.n_flights, "aircraft": problem.aircraft_count,
            "conflicting_pairs": len(problem.conflicts), "solver": profile.solver, "profile": profile.name or profile.solver,
@@ -92,7 +91,7 @@ def solve_row(name: str, problem, profile, seed: int) -> dict:
            "objective_kind": problem.objective_kind}
     t0 = time.perf_counter()
     try:
-        schedule = solve(problem, dataclasses.replace(profile, seed=seed))
+        schedule = solve(problem, profile, seed=seed)
         wall = time.perf_counter() - t0
         row.update(schedule_row(problem, schedule, wall))
         row.update(wall_seconds=wall, solve_seconds=schedule.solve_seconds,

@@ -1,4 +1,4 @@
-"""One case of a sweep, run to its stage with the pipeline's stage functions: ``run_case``.
+"""One case of a sweep, run to its stage with the pipeline's functions (uamopt/pipeline.py): ``run_case``.
 
 The rows it returns are plain dicts (one per solver × seed at stage ``schedule``, one otherwise);
 the engine adds the case id, the swept values and the version. A failure inside a case becomes
@@ -21,16 +21,10 @@ Row keys by stage (INTERFACES.md "Sweep files"):
 
 from __future__ import annotations
 
-import dataclasses
 import math
-import tempfile
 import time
-from pathlib import Path
 
 import numpy as np
-
-PLAN_METRICS = ("risk_cost", "transport_cost", "length_m", "n_waypoints")
-
 
 def error_line(exc: BaseException) -> str:
     """An exception as one short line: ``Type: message`` (a UamoptError's own line)."""
@@ -41,27 +35,15 @@ def error_line(exc: BaseException) -> str:
     return f"{type(exc).__name__}: {first}"[:400]
 
 
-def risk_metrics(run) -> dict:
+def risk_metrics(scenario, field) -> dict:
     """Unsafe shares of the whole grid, the band and the cruise layer; mean risk at cruise."""
-    from uamopt.stages import risk_summary
-
-    summary = risk_summary(run)
-    f, g = run.field, run.grid
-    k = min(math.floor(run.scenario.network.cruise_altitude_m / g.cell[2]), g.shape[2] - 1)
-    free = ~f.obstacle[:, :, k]
+    summary = field.summary()
+    g = field.grid
+    k = min(math.floor(scenario.network.cruise_altitude_m / g.cell[2]), g.shape[2] - 1)
+    free = ~field.obstacle[:, :, k]
     return {"unsafe_share": summary["unsafe_share"], "band_unsafe_share": summary["band_unsafe_share"],
-            "cruise_unsafe_share": float(f.unsafe[:, :, k][free].mean()) if free.any() else math.nan,
-            "cruise_mean_risk": float(np.nanmean(f.risk[:, :, k][free])) if free.any() else math.nan}
-
-
-def verify_schedule(problem, schedule) -> bool:
-    """The independent verifier (uamopt/schedule/verify.py) on the written schedule files."""
-    from uamopt.schedule import write_schedule
-    from uamopt.schedule.verify import verify_dir
-
-    with tempfile.TemporaryDirectory(prefix="uamopt-verify-") as tmp:
-        write_schedule(Path(tmp) / "s", problem, schedule)
-        return not verify_dir(Path(tmp) / "s")
+            "cruise_unsafe_share": float(field.unsafe[:, :, k][free].mean()) if free.any() else math.nan,
+            "cruise_mean_risk": float(np.nanmean(field.risk[:, :, k][free])) if free.any() else math.nan}
 
 
 def found_solution(schedule) -> bool:
@@ -71,7 +53,10 @@ def found_solution(schedule) -> bool:
 
 def schedule_row(problem, schedule, seconds: float) -> dict:
     """A solved instance as a row; objective and gap are NaN where undefined (no incumbent, no
-    bound, or an objective of 0, where a relative gap divides by zero), never a sentinel."""
+    bound, or an objective of 0, where a relative gap divides by zero), never a sentinel.
+    ``verified``: the independent verifier on the written schedule files (``uamopt.verify``)."""
+    from uamopt.pipeline import verify
+
     solved = found_solution(schedule)
     objective = schedule.objective if solved and schedule.objective is not None else math.nan
     bound = schedule.bound if schedule.bound is not None else math.nan
@@ -81,57 +66,48 @@ def schedule_row(problem, schedule, seconds: float) -> dict:
     return {"status": schedule.status, "objective": objective, "bound": bound, "gap": gap,
             "operated": schedule.operated_count, "cancelled": schedule.cancelled,
             "total_delay_s": schedule.total_delay_s, "avg_delay_s": schedule.avg_delay_s,
-            "verified": verify_schedule(problem, schedule), "seconds": seconds}
+            "verified": verify(problem, schedule).ok, "seconds": seconds}
 
 
-def network_routes(model) -> tuple[dict, dict]:
-    """Every route planned (Sec. 6.2): route name -> waypoints, and the metrics summed over routes."""
-    from uamopt.planning.network import plan_network
-
-    plans = plan_network(model)
-    stages = [plan.stages["optimal"] for _, _, plan, _ in plans.values()]
-    totals = {"risk_cost": sum(s.risk_cost for s in stages), "transport_cost": sum(s.transport_cost for s in stages),
-              "length_m": sum(s.length_m for s in stages), "n_waypoints": sum(s.n_waypoints for s in stages)}
-    return {name: np.asarray(plan.stages["optimal"].waypoints) for name, (_, _, plan, _) in plans.items()}, totals
+def network_totals(network) -> dict:
+    """The plan metrics summed over every directed route of a RouteNetwork."""
+    routes = network.to_frame()
+    return {"risk_cost": float(routes["risk_cost"].sum()), "transport_cost": float(routes["transport_cost"].sum()),
+            "length_m": float(routes["length_m"].sum()), "n_waypoints": int(routes["n_waypoints"].sum())}
 
 
-def scheduling_problem(scenario, network: dict, seed: int):
+def scheduling_problem(scenario, network, seed: int):
     """The generated flight plan (plan seed = ``schedule.plan_seed`` + ``seed``) and its model."""
-    from uamopt.schedule import build_problem
-    from uamopt.solvers.calibration import paper_case_plan
+    from uamopt.pipeline import build_problem, generate_flights
 
-    sc = scenario.schedule
-    flights = paper_case_plan(scenario, network, sc.plan_seed + seed, max_delay_scale=sc.max_delay_scale,
-                              first_departure_window_s=sc.first_departure_window_s, departure_step_s=sc.departure_step_s)
-    return build_problem(flights, scenario, objective=sc.objective)
+    return build_problem(generate_flights(scenario, network, scenario.schedule.plan_seed + seed), scenario)
 
 
 def _plan_row(model) -> dict:
-    from uamopt.planning import plan_track
+    from uamopt.pipeline import plan_track
 
     t0 = time.perf_counter()
-    plan = plan_track(model, model.scenario.tracks.origin, model.scenario.tracks.destination)
-    best = plan.stages["optimal"]
+    best = plan_track(model).stages["optimal"]  # the scenario's route (tracks.route, else P_O → P_D)
     return {"status": "ok", "objective": best.objective, "risk_cost": best.risk_cost, "transport_cost": best.transport_cost,
             "length_m": best.length_m, "n_waypoints": best.n_waypoints, "seconds": time.perf_counter() - t0}
 
 
-def _schedule_rows(scenario, network: dict, totals: dict, solvers, seeds) -> list[dict]:
-    from uamopt.solvers import solve
+def _schedule_rows(scenario, network, common: dict, solvers, seeds) -> list[dict]:
+    from uamopt.pipeline import solve
 
     rows = []
     for seed in seeds:
         try:
             problem = scheduling_problem(scenario, network, seed)
         except Exception as exc:  # noqa: BLE001 - recorded in the rows
-            rows += [{"solver": p.name, "seed": seed, **totals, "status": "error", "error": error_line(exc)} for p in solvers]
+            rows += [{"solver": p.name, "seed": seed, **common, "status": "error", "error": error_line(exc)} for p in solvers]
             continue
         size = {"flights": problem.n_flights, "aircraft": problem.aircraft_count, "conflicting_pairs": len(problem.conflicts)}
         for profile in solvers:
-            row = {"solver": profile.name, "seed": seed, **size, **totals}
+            row = {"solver": profile.name, "seed": seed, **size, **common}
             try:
                 t0 = time.perf_counter()
-                schedule = solve(problem, dataclasses.replace(profile, seed=seed))
+                schedule = solve(problem, profile, seed=seed)
                 row.update(schedule_row(problem, schedule, time.perf_counter() - t0))
             except Exception as exc:  # noqa: BLE001 - recorded in the row
                 row.update(status="error", error=error_line(exc))
@@ -158,25 +134,24 @@ def run_case(scenario, stage: str, solvers=(), seeds=(0,)) -> list[dict]:
     list of dict
         Never raises for a failing case: its rows carry ``status = "error"`` and ``error``.
     """
-    from uamopt.planning import planning_model
-    from uamopt.stages import compute_risk
+    from uamopt.pipeline import compute_risk, plan_network, planning_model
 
     schedule = stage == "schedule"
     keys = [{"solver": p.name, "seed": s} for p in solvers for s in seeds] if schedule else [{}]
     try:
         t0 = time.perf_counter()
-        run = compute_risk(scenario)
-        common = {**risk_metrics(run), "seconds": time.perf_counter() - t0}
+        field = compute_risk(scenario)
+        common = {**risk_metrics(scenario, field), "seconds": time.perf_counter() - t0}
         if stage == "risk":
             return [{**common, "status": "ok"}]
-        model = planning_model(scenario, run.field)
+        model = planning_model(scenario, field)
         if stage == "plan":
             return [{**common, **_plan_row(model)}]
         t0 = time.perf_counter()
-        network, totals = network_routes(model)
+        network = plan_network(model)
+        common |= network_totals(network)
         if stage == "network":
-            return [{**common, **totals, "status": "ok", "seconds": time.perf_counter() - t0}]
-        rows = _schedule_rows(scenario, network, {**common, **totals}, solvers, seeds)
-        return rows
+            return [{**common, "status": "ok", "seconds": time.perf_counter() - t0}]
+        return _schedule_rows(scenario, network, common, solvers, seeds)
     except Exception as exc:  # noqa: BLE001 - a failing case is a row, not a crash
         return [{**k, "status": "error", "error": error_line(exc)} for k in keys]

@@ -29,6 +29,7 @@ from pathlib import Path
 import numpy as np
 from matplotlib.figure import Figure
 
+from uamopt.planning.endpoints import as_endpoint
 from uamopt.planning.problem import PlanningModel
 from uamopt.planning.search import grid_search
 from uamopt.planning.tracks import STAGES, TrackPlan, endpoint_cell, track_metrics
@@ -118,8 +119,9 @@ def weight_sweep(model: PlanningModel, origin, destination, weights: int | Seque
     UamoptError, NoTrackError
         As :func:`plan_track`, for the end points.
     """
-    start = endpoint_cell(model, np.asarray(origin, dtype=float), "origin")
-    goal = endpoint_cell(model, np.asarray(destination, dtype=float), "destination")
+    o, d = as_endpoint(model.scenario, origin, "origin"), as_endpoint(model.scenario, destination, "destination")
+    start = endpoint_cell(model, np.asarray(o.point, dtype=float), "origin", o.where)
+    goal = endpoint_cell(model, np.asarray(d.point, dtype=float), "destination", d.where)
     eps = tie_break_weights(model)
     if not isinstance(weights, (int, np.integer)):
         pairs = [_checked_pair(p, eps) for p in weights]

@@ -121,6 +121,7 @@ class FlightSet:
     service_end_s: float = DEFAULT_SERVICE_S  # T_f, s (Eqs. 23, 26)
     outbound_gap_s: float = 240.0  # T_D, s (Eq. 28)
     return_gap_s: float = 360.0  # T_R, s (Eq. 28)
+    notes: tuple[str, ...] = ()  # how the generator adapted the plan (written to summary.json)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "cell", tuple(float(c) for c in self.cell))
@@ -134,6 +135,20 @@ class FlightSet:
 
     def __len__(self) -> int:
         return len(self.flights)
+
+    def to_frame(self):
+        """One row per flight: aircraft, route, origin, destination, speed_mps,
+        planned_departure_s, planned_arrival_s, max_delay_s, turnaround_after_s, length_m,
+        n_waypoints (pandas DataFrame indexed by flight id)."""
+        import pandas as pd
+
+        arrival = self.planned_arrival_s
+        rows = [{"flight": f.id, "aircraft": f.aircraft, "route": f.route, "origin": f.origin,
+                 "destination": f.destination, "speed_mps": f.speed_mps, "planned_departure_s": f.planned_departure_s,
+                 "planned_arrival_s": float(arrival[i]), "max_delay_s": f.max_delay_s,
+                 "turnaround_after_s": f.turnaround_after_s, "length_m": f.length_m,
+                 "n_waypoints": len(f.waypoints)} for i, f in enumerate(self.flights)]
+        return pd.DataFrame(rows).set_index("flight")
 
     # --- per-aircraft chains ------------------------------------------------------------
     @cached_property
