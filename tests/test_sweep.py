@@ -7,7 +7,6 @@ table row for row (timing aside). Solvers: real greedy and real HiGHS; workers: 
 
 from __future__ import annotations
 
-import json
 import os
 import shutil
 import signal
@@ -53,44 +52,6 @@ def assert_one_line_error(proc, fragment: str) -> None:
 
 def snapshot(folder: Path) -> dict:
     return {p.relative_to(folder): p.read_bytes() for p in sorted(folder.rglob("*")) if p.is_file()}
-
-
-def stop(procs: list) -> None:
-    for p in reversed(procs):
-        p.terminate()
-    for p in procs:
-        try:
-            p.wait(timeout=30)
-        except subprocess.TimeoutExpired:
-            p.kill()
-            p.wait()
-
-
-@pytest.fixture(scope="module")
-def cluster(tmp_path_factory) -> str:
-    """A separately started ``dask scheduler`` and two ``dask worker`` processes on loopback
-    (random free ports); yields the scheduler's address."""
-    from distributed import Client
-
-    folder = tmp_path_factory.mktemp("cluster")
-    dask = Path(sys.executable).parent / "dask"
-    scheduler_file = folder / "scheduler.json"
-    quiet = {"stdout": subprocess.DEVNULL, "stderr": subprocess.DEVNULL, "cwd": folder}
-    procs = [subprocess.Popen([str(dask), "scheduler", "--host", "127.0.0.1", "--port", "0", "--no-dashboard",
-                               "--scheduler-file", str(scheduler_file)], **quiet)]
-    try:
-        deadline = time.monotonic() + 60
-        while not scheduler_file.exists() and time.monotonic() < deadline:
-            time.sleep(0.1)
-        address = json.loads(scheduler_file.read_text())["address"]
-        for _ in range(2):
-            procs.append(subprocess.Popen([str(dask), "worker", address, "--nthreads", "1", "--no-dashboard",
-                                           "--host", "127.0.0.1"], **quiet))
-        with Client(address, timeout=30) as client:
-            client.wait_for_workers(2, timeout=120)
-        yield address
-    finally:
-        stop(procs)
 
 
 @pytest.fixture(scope="module")

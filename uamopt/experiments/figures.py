@@ -44,7 +44,7 @@ def _x_values(table, key: str) -> list:
     return list(dict.fromkeys(table[key].tolist()))
 
 
-def _by_solver(table, key: str, y, ax, ylabel: str) -> None:
+def _by_solver(table, key: str, y, ax, ylabel: str, xlabel: str) -> None:
     """Median over seeds (line) and the seeds' range (band) per solver, against ``key``."""
     ok = table[table["status"] != "error"]
     xs = _x_values(table, key)
@@ -58,7 +58,7 @@ def _by_solver(table, key: str, y, ax, ylabel: str) -> None:
         ax.fill_between(pos, [g.min() for _, g in stats], [g.max() for _, g in stats], alpha=0.15)
     if not numeric:
         ax.set_xticks(range(len(xs)), [str(x) for x in xs])
-    ax.set_xlabel(key)
+    ax.set_xlabel(xlabel)
     ax.set_ylabel(ylabel)
     ax.grid(alpha=0.3)
     ax.legend()
@@ -66,11 +66,12 @@ def _by_solver(table, key: str, y, ax, ylabel: str) -> None:
 
 def _delays(table, key: str, ax, label: str):
     fig, axes = _axes(ax, 2)
-    _by_solver(table, key, lambda r: r["avg_delay_s"], axes[0], "average delay T_d (s, Eq. 21)")
-    axes[0].set_title(f"Average delay per {label}")
+    _by_solver(table, key, lambda r: r["avg_delay_s"], axes[0], "average delay T_d (s, Eq. 21)", label)
+    axes[0].set_title("Average delay (median over seeds, band: range)")
     if len(axes) > 1:
-        _by_solver(table, key, lambda r: 100.0 * r["operated"] / r["flights"], axes[1], "planned flights operated (%)")
-        axes[1].set_title(f"Task fulfilment per {label}")
+        _by_solver(table, key, lambda r: 100.0 * r["operated"] / r["flights"], axes[1], "planned flights operated (%)",
+                   label)
+        axes[1].set_title("Task fulfilment")
     return fig
 
 
