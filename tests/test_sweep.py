@@ -161,6 +161,15 @@ def test_bad_sweep_file(tmp_path, capsys, body, fragment):
     assert not out.exists()
 
 
+def test_bad_options(tmp_path, capsys):
+    out = tmp_path / "out"
+    assert_one_line_error(cli(capsys, "sweep", TINY, "--out", out, "--workers", 0), "--workers must be a whole number")
+    assert_one_line_error(cli(capsys, "sweep", TINY, "--out", out, "--workers", 2, "--scheduler", "tcp://127.0.0.1:9"),
+                          "--workers applies to the local cluster")
+    assert_one_line_error(cli(capsys, "sweep", tmp_path / "missing.toml", "--out", out), "sweep file not found")
+    assert not out.exists()
+
+
 def test_unreachable_scheduler_fails_fast_and_touches_nothing(reference, tmp_path, capsys):
     out = tmp_path / "partial"
     shutil.copytree(reference, out)

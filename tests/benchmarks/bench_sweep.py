@@ -3,8 +3,8 @@
     nice -n 10 .venv/bin/python tests/benchmarks/bench_sweep.py [--workers 2] [--cases 16]
 
 Both runs execute the same sweep file (written to a temporary folder: the paper case at 50 m cells,
-``[grid]`` over the number of aircraft and the cruise speed, the preliminary strategy and SOA with
-a 60-generation budget) into fresh results folders, one after the other in this process: first with
+``[grid]`` over the number of aircraft and the cruise speed, the preliminary strategy and SOA's
+profile: about 5 CPU seconds a case, so that the cluster's start-up, a few seconds, is amortised) into fresh results folders, one after the other in this process: first with
 ``workers = 1`` (serial, the same local-cluster machinery), then with ``--workers``. Printed: the
 wall time of each, the speed-up, the CPU seconds the run consumed (this process and its workers) and so the
 cores it actually got on average, the summed per-case solver seconds, the load average before and
@@ -28,21 +28,12 @@ sys.path.insert(0, str(ROOT))
 SWEEP = """# scale-out benchmark: {cases} cases
 base = "{base}"
 stage = "schedule"
-solvers = ["greedy", "{soa}"]
+solvers = ["greedy", "soa"]
 seeds = [0]
 [grid]
 "schedule.aircraft" = [16, 20]
 "aircraft.cruise_speed_mps" = {speeds}
 """
-
-SOA = """solver = "soa"
-time_limit_s = 60.0
-seed = 0
-[options]
-generations = 60
-population = 50
-"""
-
 
 def load() -> str:
     return " ".join(f"{v:.2f}" for v in os.getloadavg())
@@ -76,10 +67,9 @@ def main() -> None:
     speeds = [round(19.0 + 12.0 * i / max(1, args.cases // 2 - 1), 2) for i in range(args.cases // 2)]
     with tempfile.TemporaryDirectory(prefix="bench-sweep-") as tmp:
         folder = Path(tmp)
-        (folder / "soa60.toml").write_text(SOA)
         path = folder / "scale.toml"
         path.write_text(SWEEP.format(cases=args.cases, base=(ROOT / "models" / "paper_case.toml").as_posix(),
-                                     soa=(folder / "soa60.toml").as_posix(), speeds=speeds))
+                                     speeds=speeds))
         print(f"{args.cases} cases, {os.cpu_count()} CPUs, load average at start {load()}", flush=True)
         serial, a = timed(path, folder / "serial", 1)
         parallel, b = timed(path, folder / f"w{args.workers}", args.workers)

@@ -66,7 +66,7 @@ def summary(table):
             "status": ", ".join(f"{s} ×{n}" for s, n in statuses.items()),
             "objective median": median,
             "objective range": f"{_num(obj.min())} – {_num(obj.max())}" if len(obj) else "-",
-            "to best known": distance(median, best.get(instance, math.nan)),
+            "to best known %": 100.0 * distance(median, best.get(instance, math.nan)),
             "gap median": float(runs["gap"].median()) if runs["gap"].notna().any() else math.nan,
             "wall s median": float(runs["wall_seconds"].median()),
             "wall s max": float(runs["wall_seconds"].max()),
@@ -130,11 +130,11 @@ def bench_markdown(table) -> str:
              f"{', '.join(sorted(set(table['objective_kind'])))}; {os.cpu_count()} CPUs, load average {load} at the end.",
              "", "## Instances", ""] + _markdown(instances, list(instances.columns))
     lines += ["", "## By solver profile (median and range over seeds)", "",
-              "`to best known` = (median objective − best known) / |best known|; `gap` = |objective − bound| / |objective| "
+              "`to best known %` = 100 (median objective − best known) / |best known|; `gap` = |objective − bound| / |objective| "
               "as the solver reports its bound (empty where undefined); `solve s` is the solver's own clock, which the "
               "time limit bounds, `build s` the rest of the wall time (model building, data transfer).", ""]
     lines += _markdown(summary(table), ["instance", "profile", "runs", "verified", "status", "objective median",
-                                        "objective range", "to best known", "gap median", "wall s median", "wall s max",
+                                        "objective range", "to best known %", "gap median", "wall s median", "wall s max",
                                         "solve s median", "build s median"])
     if table["instance"].nunique() > 1:
         lines += ["", "## Performance profile", "", "![performance profile](performance_profile.png)"]

@@ -46,8 +46,6 @@ def connect(scheduler: str | None, workers: int | None, tasks: int):
     """
     from distributed import Client, LocalCluster
 
-    if workers is not None and workers < 1:
-        raise UamoptError(f"--workers must be at least 1, got {workers}", "--workers", "give a number of worker processes")
     if scheduler:
         address = scheduler if "://" in scheduler else f"tcp://{scheduler}"
         logging.getLogger("distributed").setLevel(logging.ERROR)
@@ -173,6 +171,11 @@ def sweep(path, out=None, scheduler: str | None = None, workers: int | None = No
         Bad sweep file, unreachable scheduler, a results folder that is not this sweep's or is
         corrupt; raised before anything runs or is written.
     """
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
+        raise UamoptError(f"--workers must be a whole number ≥ 1, got {workers!r}", "--workers", "give a number of worker processes")
+    if workers is not None and scheduler:
+        raise UamoptError("--workers applies to the local cluster, not to --scheduler", "--workers",
+                          "drop --workers (the cluster's workers are started with `dask worker`)")
     spec = load_sweep(path, small=small)
     temporary = out is None
     folder = ResultsFolder(tempfile.mkdtemp(prefix="uamopt-sweep-") if temporary else out)
