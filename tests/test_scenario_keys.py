@@ -85,6 +85,44 @@ def test_flights_held_while_speed_varies(tmp_path, network_file):
     assert "plan_notes" not in held
 
 
+SMALL_LADDER = ["grid.extent=[5000.0,5000.0,360.0]", "network.random_vertiports=4", "network.tracks='straight'",
+                "schedule.aircraft=8", "schedule.flights=40"]
+
+
+def flights_command(out: Path, *overrides: str) -> dict:
+    args = ["flights", str(ROOT / "models" / "benchmark_300.toml"), "--out", str(out)]
+    for item in (*SMALL_LADDER, *overrides):
+        args += ["--set", item]
+    assert main(args) == 0
+    return json.loads((out / "flights.json").read_text())
+
+
+def test_instance_generator_random_vertiports_straight_tracks(tmp_path):
+    doc = flights_command(tmp_path / "a")
+    flights = doc["flights"]
+    assert len(flights) == 40 and len({f["aircraft"] for f in flights}) == 8
+    ends = {}
+    for f in flights:
+        w = np.asarray(f["waypoints"])
+        assert w.shape == (2, 3) and w[0, 2] == w[1, 2]  # straight and level
+        ends[f["origin"]] = w[0, :2]
+        assert w[0, 2] == (120.0 if f["origin"] < f["destination"] else 180.0)  # b->a r + 1 = 2 layers up
+    pts = np.array(list(ends.values()))
+    assert len(pts) >= 2 and np.all((pts >= 300) & (pts <= 4700))
+    assert min(np.linalg.norm(a - b) for i, a in enumerate(pts) for b in pts[i + 1:]) >= 500
+    assert flights_command(tmp_path / "b")["flights"] == flights  # same seed, same instance
+    other = flights_command(tmp_path / "c", "network.vertiport_seed=1")["flights"]
+    assert [f["waypoints"] for f in other] != [f["waypoints"] for f in flights]
+    summary = json.loads((tmp_path / "a" / "summary.json").read_text())
+    assert summary["flights"] == 40 and summary["tracks"] == "straight" and summary["vertiports"] == 4
+
+
+def test_random_vertiports_need_an_extent(tmp_path, capsys):
+    assert main(["flights", str(ROOT / "models" / "helsinki.toml"), "--set", "network.random_vertiports=3",
+                 "--out", str(tmp_path / "x")]) == 2
+    assert "needs grid.extent" in capsys.readouterr().err and not (tmp_path / "x").exists()
+
+
 # --- dead keys ----------------------------------------------------------------------------------
 
 #: Keys read only by `uamopt reproduce` and its report (checked statically below: reproduce is too
@@ -122,6 +160,8 @@ def test_every_scenario_key_is_read(tmp_path, network_file, monkeypatch):
     # synthetic city: risk, tracks, network, plan, schedule
     assert main(["plan", str(PAPER_CASE), "--out", str(tmp_path / "plan")]) == 0
     assert main(["schedule", str(PAPER_CASE), "--solver", "greedy", "--out", str(tmp_path / "sched")]) == 0
+    # the instance generator: random vertiports, straight tracks
+    flights_command(tmp_path / "ladder")
     # OpenStreetMap city (bundled Helsinki extract), coarse cells
     assert main(["risk", str(ROOT / "models" / "helsinki.toml"), "--set", "grid.cell=[50,50,30]",
                  "--set", "city.bbox=[24.935,60.164,24.952,60.175]", "--out", str(tmp_path / "osm")]) == 0
@@ -134,3 +174,20 @@ def test_every_scenario_key_is_read(tmp_path, network_file, monkeypatch):
         assert text in (ROOT / "uamopt" / module).read_text(), key
     dead = sorted(every - read - set(READ_BY_REPRODUCE))
     assert not dead, f"scenario keys never read: {dead}"
+
+
+@pytest.mark.parametrize("override, fragment", [
+    ("grid.cell=[true,true,true]", "must be a number"),
+    ("city.seed=true", "valid integer"),
+    ('city.seed="7"', "valid integer"),
+    ("city.seed=-1", "greater than or equal to 0"),
+    ("schedule.plan_seed=-3", "greater than or equal to 0"),
+    ("grid.extent=[2e5,2e5,360]", "more than the limit"),
+    ("grid.memory_limit_gb=0.005", "more than the limit of 0.0 GB"),
+])
+def test_strict_types_and_memory_guard(tmp_path, capsys, override, fragment):
+    """Bad values are one `error:` line and exit 2 before anything is allocated or written."""
+    assert main(["risk", str(PAPER_CASE), "--set", override, "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: ") and err.count("\n") == 1 and fragment in err
+    assert not (tmp_path / "out").exists()

@@ -287,6 +287,34 @@ def _scheduling_problem(scenario, args, bar):
     return problem
 
 
+def cmd_flights(args) -> int:
+    """The scenario's generated flight plan as a self-contained flights.json (the instance generator)."""
+    from uamopt.outputs import check_out_dir, staged_output, write_json
+    from uamopt.pipeline import build_problem, compute_risk, generate_flights, plan_network, planning_model
+    from uamopt.schedule import save_flights
+
+    scenario = _load(args)
+    check_out_dir(args.out)
+    with _progress(3, "flights") as bar, staged_output(args.out) as stage:
+        bar.set_description("network")
+        model = planning_model(scenario, compute_risk(scenario))
+        network = plan_network(model)
+        bar.update(1)
+        flights = generate_flights(scenario, network, args.seed)
+        bar.update(1)
+        problem = build_problem(flights, scenario)
+        save_flights(stage / "flights.json", flights)
+        write_json(stage / "summary.json", {
+            "scenario": scenario.name, "flights": len(flights), "aircraft": flights.n_aircraft,
+            "vertiports": len(scenario.network.vertiports), "directed_routes": len(network),
+            "tracks": scenario.network.tracks, "conflicting_pairs": len(problem.conflicts),
+            "seed": scenario.schedule.plan_seed if args.seed is None else args.seed, "plan_notes": list(flights.notes)})
+        bar.update(1)
+    print(f"flights: {len(flights)} flights, {flights.n_aircraft} aircraft, {len(problem.conflicts)} conflicting pairs "
+          f"-> {Path(args.out) / 'flights.json'}")
+    return 0
+
+
 def cmd_schedule(args) -> int:
     from uamopt.outputs import check_out_dir
     from uamopt.schedule import write_schedule
@@ -357,6 +385,9 @@ def build_parser() -> argparse.ArgumentParser:
     plan.add_argument("--to", dest="destination", metavar="X,Y,Z|NAME",
                       help="destination, m, or a vertiport name (default: tracks.route / tracks.destination)")
     command("network", cmd_network, "plan one track per route and direction: network.json, network.png", "out/network")
+    flights = command("flights", cmd_flights, "generate the scenario's flight plan: flights.json (the instance "
+                      "generator)", "out/flights")
+    flights.add_argument("--seed", type=int, help="seed of the generated plan (default: schedule.plan_seed)")
     sched = command("schedule", cmd_schedule, "schedule the flights: flights.json, schedule.csv, summary.json", "out/schedule")
     for p in (sched,):
         p.add_argument("--solver", required=True, metavar="PROFILE", help="solver profile: solvers/NAME.toml or NAME")

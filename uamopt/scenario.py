@@ -16,13 +16,21 @@ import tomllib
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, PrivateAttr, ValidationError, ValidationInfo, field_validator
+from pydantic import (BaseModel, BeforeValidator, ConfigDict, Field, PrivateAttr, ValidationError, ValidationInfo, field_validator,
+                      model_validator)
 
 from uamopt.errors import ScenarioError
 
-PositiveFloat = Annotated[float, Field(gt=0, allow_inf_nan=False)]
-NonNegFloat = Annotated[float, Field(ge=0, allow_inf_nan=False)]
-Fraction = Annotated[float, Field(ge=0, le=1, allow_inf_nan=False)]
+def _number(value: Any) -> Any:
+    """Numbers only: TOML's true/false and "7" are not lengths or rates (strict at the boundary)."""
+    if isinstance(value, bool) or isinstance(value, str):
+        raise ValueError("must be a number")
+    return value
+
+
+PositiveFloat = Annotated[float, BeforeValidator(_number), Field(gt=0, allow_inf_nan=False)]
+NonNegFloat = Annotated[float, BeforeValidator(_number), Field(ge=0, allow_inf_nan=False)]
+Fraction = Annotated[float, BeforeValidator(_number), Field(ge=0, le=1, allow_inf_nan=False)]
 Vec3 = tuple[PositiveFloat, PositiveFloat, PositiveFloat]
 
 
@@ -39,13 +47,17 @@ class GridConfig(_Section):
     )
     h_min_airspace: NonNegFloat = Field(30.0, description="h'_min, lowest altitude of the airspace, m (Eq. 14)")
     h_max_airspace: PositiveFloat = Field(300.0, description="h'_max, highest altitude of the airspace, m (Eq. 14)")
+    memory_limit_gb: PositiveFloat | None = Field(
+        None, description="refuse grids whose run would need more memory than this, GB (about 160 bytes per cell); "
+        "omitted: 80 % of the machine's memory"
+    )
 
 
 class CityConfig(_Section):
     """Where the ground-truth city layers come from (synthetic, OpenStreetMap or a DSM GeoTIFF)."""
 
     source: Literal["synthetic", "osm", "dsm"] = Field("synthetic", description="layer source")
-    seed: int = Field(7, description="seed of the synthetic city generator")
+    seed: Annotated[int, Field(ge=0, strict=True)] = Field(7, description="seed of the synthetic city generator")
     population_density: NonNegFloat = Field(2.5e-4, description="ρ_P, people per m² (Table B.3), uniform")
     shelter_low: Fraction = Field(0.5, description="c_s where buildings are ≤ shelter_height_m or absent")
     shelter_high: Fraction = Field(0.75, description="c_s where buildings are > shelter_height_m (Table B.3)")
@@ -139,6 +151,29 @@ def _paper_vertiports() -> tuple[Vertiport, ...]:
     return tuple(Vertiport(name=n, x=10.0 * x, y=10.0 * y) for n, (x, y) in pts.items())
 
 
+def random_vertiports(n: int, extent_m: tuple[float, float], *, margin_m: float = 300.0, seed: int = 0,
+                      spacing_m: float = 500.0) -> tuple[Vertiport, ...]:
+    """``n`` vertiports V1..Vn at seeded random whole-metre points of [margin, extent − margin]²,
+    at least ``spacing_m`` apart.
+
+    >>> [(v.name, v.x, v.y) for v in random_vertiports(2, (2000.0, 2000.0), seed=1)]
+    [('V1', 1017.0, 1631.0), ('V2', 502.0, 1628.0)]
+    """
+    import numpy as np
+
+    rng = np.random.default_rng(seed)
+    pts: list[tuple[float, float]] = []
+    for _ in range(1000 * n):
+        if len(pts) == n:
+            break
+        p = tuple(float(np.round(rng.uniform(margin_m, e - margin_m))) for e in extent_m)
+        if all(math.dist(p, q) >= spacing_m for q in pts):
+            pts.append(p)  # type: ignore[arg-type]
+    if len(pts) < n:
+        raise ValueError(f"cannot place {n} vertiports {spacing_m:g} m apart in {extent_m[0]:g} x {extent_m[1]:g} m")
+    return tuple(Vertiport(name=f"V{i + 1}", x=x, y=y) for i, (x, y) in enumerate(pts))
+
+
 class NetworkConfig(_Section):
     """Vertiports and routes (Sec. 6.2). Routes default to every pair of vertiports."""
 
@@ -148,6 +183,25 @@ class NetworkConfig(_Section):
     vertiport_clearance_m: NonNegFloat = Field(
         150.0, description="radius kept free of buildings above h_min around each vertiport (synthetic city), m"
     )
+    random_vertiports: Annotated[int, Field(ge=2, le=200, strict=True)] | None = Field(
+        None, description="N: replace the vertiports by V1..VN at seeded random whole-metre points of the grid, "
+        "300 m from its edges and 500 m apart (benchmark instances); needs grid.extent"
+    )
+    vertiport_seed: Annotated[int, Field(ge=0, strict=True)] = Field(
+        0, description="seed of network.random_vertiports"
+    )
+    tracks: Literal["planned", "straight"] = Field(
+        "planned", description="the tracks flights fly: planned by A* through the city (Sec. 4.2), or straight "
+        "lines between vertiports, a->b at the cruise altitude and b->a r + 1 layers up (scheduler benchmarks)"
+    )
+
+    def route_list(self) -> list[tuple[str, str]]:
+        """The routes (a, b): ``routes`` as given, or every pair of vertiports in their order
+        (10 for V1–V5). Each route is flown both ways (a→b and b→a)."""
+        if self.routes is not None:
+            return [(a, b) for a, b in self.routes]
+        names = [v.name for v in self.vertiports]
+        return [(a, b) for i, a in enumerate(names) for b in names[i + 1:]]
 
     @field_validator("vertiports")
     @classmethod
@@ -225,7 +279,7 @@ class ScheduleConfig(_Section):
     outbound_gap_s: NonNegFloat = Field(240.0, description="T_D, s (Eq. 28)")
     return_gap_s: NonNegFloat = Field(360.0, description="T_R, s (Eq. 28)")
     interference: NonNegFloat = Field(0.3, description="χ, interference degree coefficient (Eq. 23)")
-    aircraft: Annotated[int, Field(ge=1)] = Field(20, description="G, number of eVTOLs")
+    aircraft: Annotated[int, Field(ge=1, strict=True)] = Field(20, description="G, number of eVTOLs")
     flights: Annotated[int, Field(ge=1, strict=True)] | None = Field(
         None, description="total planned flights; ⌊flights/G⌋ per aircraft, the remainder one each over the first "
         "aircraft. Omitted: F per aircraft from Eq. 23 (20 × 6 = 120 in the paper case). Set it to hold the number "
@@ -234,13 +288,13 @@ class ScheduleConfig(_Section):
     time_step_s: PositiveFloat = Field(
         10.0, description="ΔT_a, s (Table B.3): the heuristics' delay grid and the grid of generated first departures"
     )
-    conflict_radius: Annotated[int, Field(ge=0)] = Field(1, description="r: conflict zone of (2r+1)³ cells")
+    conflict_radius: Annotated[int, Field(ge=0, le=10, strict=True)] = Field(1, description="r: conflict zone of (2r+1)³ cells")
     service_s: PositiveFloat = Field(3600.0, description="T_f − T_s, the service window, s (Eq. 23: gives F = 6)")
     first_departure_window_s: NonNegFloat = Field(
         600.0, description="first planned departures of the aircraft are drawn in [T_s, T_s + window], s; an "
         "aircraft whose flights leave less slack before T_f draws from that slack (noted in summary.json)"
     )
-    plan_seed: int = Field(0, description="seed of the initial flight plan generator")
+    plan_seed: Annotated[int, Field(ge=0, strict=True)] = Field(0, description="seed of the initial flight plan generator")
     max_delay_scale: Annotated[float, Field(gt=0, le=1)] = Field(
         1.0, description="Δd as a share of Eq. 29's bound round(L/v_g) + ΔT (Eq. 29 allows any Δd up to it)"
     )
@@ -261,6 +315,17 @@ class Scenario(_Section):
     network: NetworkConfig = NetworkConfig()
     tracks: TracksConfig = TracksConfig()
     schedule: ScheduleConfig = ScheduleConfig()
+
+    @model_validator(mode="after")
+    def _random_vertiports(self) -> "Scenario":
+        n = self.network.random_vertiports
+        if n is None:
+            return self
+        if self.grid.extent is None:
+            raise ValueError("network.random_vertiports needs grid.extent (the domain the vertiports are drawn in)")
+        ports = random_vertiports(n, (self.grid.extent[0], self.grid.extent[1]), seed=self.network.vertiport_seed)
+        object.__setattr__(self, "network", self.network.model_copy(update={"vertiports": ports, "routes": None}))
+        return self
 
     _base_dir: Path = PrivateAttr(default_factory=Path.cwd)
     _source: str = PrivateAttr(default="<defaults>")

@@ -18,7 +18,6 @@ use the whole altitude band.
 from __future__ import annotations
 
 import dataclasses
-import itertools
 import json
 from dataclasses import dataclass
 from pathlib import Path
@@ -32,10 +31,7 @@ from uamopt.planning.tracks import TrackPlan, plan_track
 
 def route_pairs(model: PlanningModel) -> list[tuple[str, str]]:
     """The scenario's routes, or every pair of vertiports (10 for V1–V5)."""
-    net = model.scenario.network
-    if net.routes is not None:
-        return [tuple(r) for r in net.routes]  # type: ignore[misc]
-    return list(itertools.combinations([v.name for v in net.vertiports], 2))
+    return model.scenario.network.route_list()
 
 
 def direction_layers(model: PlanningModel) -> tuple[int, int]:
@@ -138,6 +134,8 @@ def plan_network(model: PlanningModel, progress=None, stage: str = "optimal") ->
 
     ``progress`` (optional) gets ``update(1)`` after each track; ``stage`` picks the track the
     flights fly (Table 2's ``optimal`` by default)."""
+    if model.scenario.network.tracks == "straight":
+        return straight_routes(model, progress)
     ports = {v.name: v for v in model.scenario.network.vertiports}
     layered = model.scenario.tracks.layering == "direction"
     dz = model.field.grid.cell[2]
@@ -163,6 +161,35 @@ def plan_network(model: PlanningModel, progress=None, stage: str = "optimal") ->
             if progress is not None:
                 progress.update(1)
     return RouteNetwork(routes, tuple(model.field.grid.cell), model.scenario.name, stage,  # type: ignore[arg-type]
+                        model.scenario.tracks.layering)
+
+
+def straight_routes(model: PlanningModel, progress=None) -> RouteNetwork:
+    """``network.tracks = "straight"``: each direction a straight line between its vertiports, on
+    the layers of :func:`direction_layers` (a→b at the cruise altitude, b→a r + 1 layers up); the
+    city is not avoided. Metrics are Eqs. 10–12 of the line (scheduler benchmarks)."""
+    from uamopt.planning.tracks import track_metrics
+
+    ports = {v.name: v for v in model.scenario.network.vertiports}
+    k_out, k_back = direction_layers(model)
+    cruise, dz = model.scenario.network.cruise_altitude_m, model.field.grid.cell[2]
+    extent = np.asarray(model.field.grid.extent)
+    routes: dict[str, RouteTrack] = {}
+    for a, b in route_pairs(model):
+        for origin, destination, k in ((a, b, k_out), (b, a, k_back)):
+            z = cruise + (k - k_out) * dz
+            p, q = ports[origin], ports[destination]
+            waypoints = np.array([[p.x, p.y, z], [q.x, q.y, z]], dtype=float)
+            if np.any(waypoints < 0) or np.any(waypoints > extent):
+                raise NoTrackError(f"route {origin}-{destination} leaves the grid (extent {tuple(extent.tolist())})",
+                                   "network.vertiports", "move the vertiports inside grid.extent")
+            m = track_metrics(model, waypoints)
+            name = f"{origin}-{destination}"
+            routes[name] = RouteTrack(name, origin, destination, waypoints, m["length_m"], m["risk_cost"],
+                                      m["transport_cost"], m["buffer_cost"], k)
+            if progress is not None:
+                progress.update(1)
+    return RouteNetwork(routes, tuple(model.field.grid.cell), model.scenario.name, "straight",  # type: ignore[arg-type]
                         model.scenario.tracks.layering)
 
 

@@ -34,11 +34,8 @@ def route_name(origin: str, destination: str) -> str:
 
 
 def scenario_routes(scenario: Scenario) -> list[tuple[str, str]]:
-    """The network's routes (a, b): the scenario's list, or every pair in vertiport order."""
-    if scenario.network.routes is not None:
-        return [tuple(r) for r in scenario.network.routes]  # type: ignore[misc]
-    names = [v.name for v in scenario.network.vertiports]
-    return [(a, b) for i, a in enumerate(names) for b in names[i + 1:]]
+    """The network's routes (a, b) (:meth:`uamopt.scenario.NetworkConfig.route_list`)."""
+    return scenario.network.route_list()
 
 
 def straight_network(scenario: Scenario, grid: AirspaceGrid, *, layer_offset_cells: int = 1) -> dict[str, np.ndarray]:
@@ -91,23 +88,14 @@ def flights_per_aircraft(
 
 
 def grid_vertiports(n: int, extent_m: tuple[float, float], *, margin_m: float = 300.0, seed: int = 0) -> tuple[Vertiport, ...]:
-    """``n`` vertiports V1..Vn at seeded random whole-metre points of [margin, extent − margin]².
+    """``n`` vertiports V1..Vn at seeded random whole-metre points of [margin, extent − margin]², at
+    least 500 m apart (:func:`uamopt.scenario.random_vertiports`, the ``network.random_vertiports`` key)."""
+    from uamopt.scenario import random_vertiports
 
-    For benchmarks on larger domains; at least 500 m apart where the domain allows it.
-    """
-    from uamopt.scenario import Vertiport
-
-    rng = np.random.default_rng(seed)
-    pts: list[tuple[float, float]] = []
-    for _ in range(1000 * n):
-        if len(pts) == n:
-            break
-        p = tuple(float(np.round(rng.uniform(margin_m, e - margin_m))) for e in extent_m)
-        if all(math.dist(p, q) >= 500.0 for q in pts):
-            pts.append(p)  # type: ignore[arg-type]
-    if len(pts) < n:
-        raise UamoptError(f"cannot place {n} vertiports 500 m apart", f"extent {extent_m}", "enlarge the domain")
-    return tuple(Vertiport(name=f"V{i + 1}", x=x, y=y) for i, (x, y) in enumerate(pts))
+    try:
+        return random_vertiports(n, extent_m, margin_m=margin_m, seed=seed)
+    except ValueError as exc:
+        raise UamoptError(str(exc), f"extent {extent_m}", "enlarge the domain or place fewer vertiports") from None
 
 
 def flights_per_aircraft_list(total: int, n_aircraft: int) -> list[int]:
