@@ -132,7 +132,8 @@ def bench_markdown(table) -> str:
     lines += ["", "## By solver profile (median and range over seeds)", "",
               "`to best known %` = 100 (median objective − best known) / |best known|; `gap` = |objective − bound| / |objective| "
               "as the solver reports its bound (empty where undefined); `solve s` is the solver's own clock, which the "
-              "time limit bounds, `build s` the rest of the wall time (model building, data transfer).", ""]
+              "time limit bounds, `build s` the rest of the wall time (model building, data transfer). Each solver ran "
+              "once untimed on a few flights first (imports, helper processes).", ""]
     lines += _markdown(summary(table), ["instance", "profile", "runs", "verified", "status", "objective median",
                                         "objective range", "to best known %", "gap median", "wall s median", "wall s max",
                                         "solve s median", "build s median"])

@@ -8,8 +8,10 @@ objective, bound and relative gap (NaN where undefined: no incumbent, no bound, 
 of 0), operated S (Eq. 22), cancelled, total and average delay (Eq. 21), and three times:
 ``wall_seconds`` around the whole call, ``solve_seconds`` as the solver reports it (HiGHS's and
 CP-SAT's own clocks, which the time limit bounds) and ``build_seconds`` = wall − solve (model
-building, data transfer). ``verified`` is the independent verifier's verdict on the written
-schedule (uamopt/schedule/verify.py), for every row.
+building, data transfer). Before the timed runs each solver runs once, untimed, on a few flights
+(:func:`warm_up`), so no row carries a process's one-time costs (imports, helper processes).
+``verified`` is the independent verifier's verdict on the written schedule
+(uamopt/schedule/verify.py), for every row.
 """
 
 from __future__ import annotations
@@ -81,6 +83,22 @@ def _profiles(solvers, time_limit_s):
     return profiles
 
 
+def warm_up(problems, profiles) -> None:
+    """Run each solver once, untimed, on the first aircraft's flights of an instance: the one-time
+    costs of a process (imports, HiGHS or OR-Tools helper processes) then stay out of the rows."""
+    from uamopt.pipeline import build_problem, solve
+
+    problem = next(iter(problems))
+    first = problem.flights.flights[0].aircraft
+    tiny = dataclasses.replace(problem.flights, flights=tuple(f for f in problem.flights.flights if f.aircraft == first))
+    tiny_problem = build_problem(tiny, objective=problem.objective_kind, weights=problem.weights)
+    for profile in {p.solver: p for p in profiles}.values():
+        try:
+            solve(tiny_problem, profile, time_limit_s=min(5.0, profile.time_limit_s))
+        except Exception:  # noqa: BLE001 - a broken solver shows in its own rows
+            pass
+
+
 def solve_row(name: str, problem, profile, seed: int) -> dict:
     """One benchmark row: solve, time, verify; a solver failure is an ``error`` row."""
     from uamopt.pipeline import solve
@@ -134,6 +152,7 @@ def benchmark(problem_or_scenarios, solvers, seeds=None, time_limit_s: float | N
     profiles = _profiles(solvers, time_limit_s)
     instances = _instances(problem_or_scenarios)
     runs = [(name, p, s) for name in instances for p in profiles for s in (seeds if seeds is not None else [p.seed])]
+    warm_up(instances.values(), profiles)
     rows = []
     bar = Progress(len(runs), "bench", "solves", every=True, stream=None) if progress else None
     for name, profile, seed in runs:
