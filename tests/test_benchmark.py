@@ -80,12 +80,15 @@ def test_seed_count_instance_name_and_bad_options(tmp_path, capsys):
     from uamopt.cli import main
 
     out = tmp_path / "b"
-    proc = uamopt("bench", PAPER, "--solver", "greedy", "--seeds", "3", "--set", "schedule.aircraft=10",
-                  "--set", "tracks.equivalent=midpoint", "--out", out)
-    assert proc.returncode == 0, proc.stderr
+    sets = ["schedule.aircraft=4", 'network.routes=[["V1","V5"]]', "tracks.equivalent=midpoint"]
+    code = main(["bench", str(PAPER), "--solver", "greedy", "--seeds", "3", "--out", str(out)]
+                + [arg for item in sets for arg in ("--set", item)])
+    err = capsys.readouterr().err
+    assert code == 0, err
+    assert "bench: 3/3 solves" in err  # not on a terminal: lines, not a bar
     table = pd.read_csv(out / "bench.csv")
     assert table["seed"].tolist() == [0, 1, 2]
-    assert set(table["instance"]) == {"paper_case[schedule.aircraft=10,tracks.equivalent=midpoint]"} and (table["aircraft"] == 10).all()
+    assert set(table["instance"]) == {"paper_case[" + ",".join(sets) + "]"} and (table["aircraft"] == 4).all()
     for args, fragment in ((["--time-limit", "-1"], "time limit must be a positive"), (["--seeds", "1", "1"], "no distinct seeds"),
                            (["--seeds", "0"], "no distinct seeds")):
         code = main(["bench", str(PAPER), "--solver", "greedy", "--out", str(tmp_path / "bad"), *args])
