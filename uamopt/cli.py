@@ -1,4 +1,4 @@
-"""Command line: ``uamopt COMMAND SCENARIO [--set KEY=VALUE ...] [--out DIR]`` (INTERFACES.md).
+"""Command line: ``uamopt COMMAND SCENARIO [--set KEY=VALUE ...] [--out DIR]`` (docs/interfaces.md).
 
 Bad input ends with one line ``error: <what> (<where>): <how to fix>`` on stderr and exit code 2;
 results are staged and moved into ``--out`` only when complete.
@@ -173,7 +173,7 @@ def _plan_at(scenario, side: float, extent) -> tuple:
 REPRODUCE_SOLVERS = ("greedy", "ga", "soa", "highs", "cpsat")
 
 
-def _reproduce_schedules(scenario, model, network, stage: Path, bar) -> list[str]:
+def _reproduce_schedules(scenario, model, network, stage: Path, bar, provenance: dict | None = None) -> list[str]:
     """Table 3 / Fig. 19: every solver profile on the paper-case plan over the planned network."""
     from uamopt.plot_schedule import plot_delay_comparison, plot_gantt
     from uamopt.report import is_paper_schedule, table3_section
@@ -190,7 +190,7 @@ def _reproduce_schedules(scenario, model, network, stage: Path, bar) -> list[str
             bar.set_description(f"schedule ({objective}): {name}")
             schedule = solve(problem, load_profile(name))
             folder = stage / "schedules" / objective / name
-            write_schedule(folder, problem, schedule)
+            write_schedule(folder, problem, schedule, extra=provenance)
             schedules[name], verified[name] = schedule, not verify_dir(folder)
             bar.update(1)
         suffix = "" if objective == scenario.schedule.objective else f"_{objective}"
@@ -240,7 +240,9 @@ def cmd_reproduce(args) -> int:
         bar.set_description("pareto front")
         fronts = {flag: weight_sweep(fine_model, origin, destination, 9, buffer=flag) for flag in (False, True)}
         plot_pareto(fronts[True], stage / "pareto.png", title=f"{scenario.name}: Eq. 10 + μ·R(t) trade-off")
-        sched_sections = _reproduce_schedules(scenario, model, network, stage, bar)
+        from uamopt.export.frame import schedule_provenance
+
+        sched_sections = _reproduce_schedules(scenario, model, network, stage, bar, schedule_provenance(scenario, args.set))
         sections = [risk_section(scenario, summary), table2_section(fine, fine_model, tracks, paper=paper),
                     table2_section(v_scenario, v_model, v_tracks, figure=False, paper=paper,
                                    title=f"Table 2 analogue with the variant tracks.buffer_measure = \"{other}\""),
@@ -316,6 +318,7 @@ def cmd_flights(args) -> int:
 
 
 def cmd_schedule(args) -> int:
+    from uamopt.export.frame import schedule_provenance
     from uamopt.outputs import check_out_dir
     from uamopt.schedule import write_schedule
     from uamopt.schedule.verify import verify_dir
@@ -324,12 +327,13 @@ def cmd_schedule(args) -> int:
     scenario = _load(args)
     profile = load_profile(args.solver)
     check_out_dir(args.out)
+    provenance = schedule_provenance(scenario, args.set)  # frame and scenario for the exports
     with _progress(3, "schedule") as bar:
         problem = _scheduling_problem(scenario, args, bar)
         bar.set_description(profile.solver)
         schedule = solve(problem, profile)
         bar.update(1)
-    write_schedule(args.out, problem, schedule)
+    write_schedule(args.out, problem, schedule, extra=provenance)
     problems = verify_dir(args.out)
     print(f"{schedule.solver}: {schedule.status}, objective {schedule.objective}, operated {schedule.operated_count}, "
           f"cancelled {schedule.cancelled}, total delay {schedule.total_delay_s:.1f} s, "
@@ -413,6 +417,9 @@ def build_parser() -> argparse.ArgumentParser:
     from uamopt.experiments.engine import add_sweep_command
 
     add_sweep_command(sub)
+    from uamopt.export.cli import add_export_commands
+
+    add_export_commands(sub)  # export bluesky | geojson, replay
     return parser
 
 

@@ -184,8 +184,19 @@ def pareto_front(model: PlanningModel, origin, destination, weights: int | Seque
 
     Examples
     --------
-    >>> front = pareto_front(model, (300, 300, 120), (2220, 4220, 120), 9)  # doctest: +SKIP
-    >>> [(round(p.transport_cost, 2), round(p.risk_cost)) for p in front]  # doctest: +SKIP
+    Table B.3's synthetic city on 100 m cells, V1 → V4 at 120 m:
+
+    >>> from uamopt.planning import planning_model
+    >>> from uamopt.scenario import Scenario
+    >>> from uamopt.stages import compute_risk
+    >>> scenario = Scenario().with_overrides(["grid.cell=[100,100,60]"])
+    >>> model = planning_model(scenario, compute_risk(scenario).field)
+    >>> front = pareto_front(model, (300, 300, 120), (2220, 4220, 120), 5, buffer=False)
+    >>> [(round(p.risk_cost), round(p.transport_cost, 2)) for p in front]
+    [(3068, 29.15), (2985, 29.52), (2902, 30.25), (2861, 30.61), (2744, 97.11)]
+    >>> with_buffer = pareto_front(model, (300, 300, 120), (2220, 4220, 120), 5)  # plus μ·R(t), Eq. 34
+    >>> [(round(p.risk_cost), round(p.transport_cost, 2)) for p in with_buffer]
+    [(3206, 99.08), (3002, 99.81), (2961, 100.18)]
     """
     return non_dominated(weight_sweep(model, origin, destination, weights, buffer=buffer))
 
