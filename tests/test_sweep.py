@@ -126,6 +126,24 @@ def test_library_call_on_a_finished_folder_runs_nothing(reference, tmp_path):
     pd.testing.assert_frame_equal(table, pd.read_parquet(reference / "results.parquet"))
 
 
+def test_extending_the_grid_runs_only_the_new_cases(reference, cluster, tmp_path):
+    import uamopt as ua
+
+    out = tmp_path / "extended"
+    shutil.copytree(reference, out)
+    saved = snapshot(out / "parts")
+    wider = tmp_path / "wider.toml"
+    wider.write_text(TINY.read_text().replace("[20.0, 30.0]", "[20.0, 30.0, 25.0]").replace(
+        'base = "../../../models/paper_case.toml"', f'base = "{PAPER.as_posix()}"'))
+    table = ua.sweep(wider, out=out, scheduler=cluster)
+    assert table.attrs["run"] == 2 and len(table) == 12
+    assert table["aircraft.cruise_speed_mps"].tolist() == [20.0, 20.0, 30.0, 30.0, 25.0, 25.0] * 2
+    assert all(snapshot(out / "parts")[name] == data for name, data in saved.items())
+    old = pd.read_parquet(reference / "results.parquet")
+    kept = table[table["case"].isin(old["case"])].reset_index(drop=True)
+    pd.testing.assert_frame_equal(without_timing(kept), without_timing(old))
+
+
 def test_a_failing_case_is_a_row_not_a_crash(cluster, tmp_path):
     """290 m cruise: the return direction's layer lies above the band (h'_max = 300 m)."""
     import uamopt as ua
