@@ -152,3 +152,25 @@ def test_progress_lines_when_not_on_a_terminal():
             bar.update(1, f"run {i}")
     assert stream.getvalue().splitlines()[0].startswith("bench: 0/3 solves")
     assert [l.split(" - ")[-1] for l in stream.getvalue().splitlines()[1:]] == ["run 0", "run 1", "run 2", "done"]
+
+
+def test_progress_bar_on_a_terminal():
+    """On a terminal (a real pseudo-terminal here) the progress is a tqdm bar redrawn in place."""
+    import os
+    import pty
+    import time
+
+    from uamopt.experiments.progress import Progress
+
+    master, slave = pty.openpty()
+    with os.fdopen(slave, "w") as stream:
+        assert stream.isatty()
+        with Progress(3, "sweep demo", "cases", stream=stream) as bar:
+            for _ in range(3):
+                time.sleep(0.15)  # tqdm redraws at most every 0.1 s
+                bar.update(1)
+        stream.flush()
+        output = os.read(master, 65536).decode(errors="replace")
+    os.close(master)
+    assert "sweep demo" in output and "3/3" in output and "\r" in output
+    assert "- started" not in output  # no plain lines on a terminal
