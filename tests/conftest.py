@@ -61,6 +61,45 @@ def paper_straight_plan():
 
 
 @pytest.fixture(scope="session")
+def cluster(tmp_path_factory) -> str:
+    """A separately started ``dask scheduler`` and two ``dask worker`` processes on loopback
+    (random free ports); yields the scheduler's address."""
+    import json
+    import subprocess
+    import sys
+    import time
+
+    from distributed import Client
+
+    folder = tmp_path_factory.mktemp("cluster")
+    dask = Path(sys.executable).parent / "dask"
+    scheduler_file = folder / "scheduler.json"
+    quiet = {"stdout": subprocess.DEVNULL, "stderr": subprocess.DEVNULL, "cwd": folder}
+    procs = [subprocess.Popen([str(dask), "scheduler", "--host", "127.0.0.1", "--port", "0", "--no-dashboard",
+                               "--scheduler-file", str(scheduler_file)], **quiet)]
+    try:
+        deadline = time.monotonic() + 60
+        while not scheduler_file.exists() and time.monotonic() < deadline:
+            time.sleep(0.1)
+        address = json.loads(scheduler_file.read_text())["address"]
+        for _ in range(2):
+            procs.append(subprocess.Popen([str(dask), "worker", address, "--nthreads", "1", "--no-dashboard",
+                                           "--host", "127.0.0.1"], **quiet))
+        with Client(address, timeout=30) as client:
+            client.wait_for_workers(2, timeout=120)
+        yield address
+    finally:
+        for p in reversed(procs):
+            p.terminate()
+        for p in procs:
+            try:
+                p.wait(timeout=30)
+            except subprocess.TimeoutExpired:
+                p.kill()
+                p.wait()
+
+
+@pytest.fixture(scope="session")
 def paper_schedule_dir(tmp_path_factory) -> Path:
     """A schedule folder of the paper case (highs, planned network) written by ``uamopt schedule``.
 

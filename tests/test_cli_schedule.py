@@ -53,12 +53,7 @@ def test_schedule_verify_and_bench(tmp_path, capsys):
     code, stdout, _ = cli(capsys, "verify", str(out))
     overlaps = [line for line in stdout.splitlines() if "overlap" in line]
     assert code == 1 and overlaps and all(f"{f[0]} ({f[1]})" in overlaps[0] for f in (first, twin))
-    bench = tmp_path / "bench"
-    code, _, err = cli(capsys, "bench", PAPER, "--solver", "greedy", "cpsat", "--out", str(bench))
-    assert code == 0, err
-    csv_rows = (bench / "bench.csv").read_text().splitlines()
-    assert len(csv_rows) == 3 and csv_rows[1].endswith("yes") and csv_rows[2].endswith("yes")
-    assert (bench / "bench.md").exists()
+    # `uamopt bench`: tests/test_benchmark.py
 
 
 def test_schedule_bad_input(tmp_path, capsys):
