@@ -10,23 +10,21 @@ cells = [
 
 This notebook builds the operational risk field of `models/paper_case.toml` stage by stage
 (scenario → city layers → airspace grid → risk field), checks the physical models against the
-reference numbers of `MODEL_NOTES.md`, draws the risk map and reports the share of unsafe cells
+reference numbers of `docs/readings.md`, draws the risk map and reports the share of unsafe cells
 per altitude layer.
 
 Executed by `tests/test_notebooks.py`: every `assert` below is a check, so a clean run means the
 numbers hold. Run it with the repository root (or `notebooks/`) as the working directory."""),
     code("""from pathlib import Path
 import math
-import tempfile
 from decimal import Decimal
 
 import numpy as np
 import pandas as pd
-from IPython.display import Image, display
 from scipy.integrate import solve_ivp
 
+import uamopt.plotting as plotting
 from uamopt import build_grid, load_city, load_scenario, risk_field
-from uamopt.plots import plot_risk
 from uamopt.risk import (crash_area, drag_constant, fall_time, fatality_probability, impact_energy,
                          impact_speed, mean_relative_speed, vehicle_collision_probability)
 
@@ -58,8 +56,8 @@ For a fall from rest through $h'$ = 148.2 m with quadratic drag:
   $P^P = 1/\\bigl(1 + \\sqrt{\\alpha/\\beta}\\,(\\beta/E_{imp})^{1/(4c_s)}\\bigr)$ (Eq. 3);
 - $R^P = \\lambda N^P P^P$ with $N^P = \\rho_P S_e$ (Eqs. 1–2).
 
-The reference column is `MODEL_NOTES.md`, copied as printed. Each value is asserted to 10⁻⁶
-relative, or to half a unit of the last printed digit where the notes print fewer digits than
+The reference column is `docs/readings.md` (Reference numbers), copied as printed. Each value is asserted to 10⁻⁶
+relative, or to half a unit of the last printed digit where the reference prints fewer digits than
 that (the terminal speeds, 5 significant digits, and P^P at c_s = 0.75 for 220 kg, which rounds
 0.1465352 to 0.146535). The terminal speed is also asserted to 10⁻¹² against the closed form
 $\\sqrt{2(m_e+m_p)g/(R_I\\rho_a S_e)}$."""),
@@ -67,7 +65,7 @@ $\\sqrt{2(m_e+m_p)g/(R_I\\rho_a S_e)}$."""),
 g = r.gravity_mps2
 area = crash_area(a.length_m)
 height = 148.2  # h', m
-reference = {  # MODEL_NOTES.md as printed, (m_p = 0 kg, m_p = 220 kg)
+reference = {  # docs/readings.md as printed, (m_p = 0 kg, m_p = 220 kg)
     "terminal speed (m/s)": ("27.468", "34.198"),
     "v from 148.2 m, A.3 (m/s)": ("27.174496", "32.740228"),
     "fall time from 148.2 m (s)": ("7.323078", "6.677222"),
@@ -107,7 +105,7 @@ for column, payload in enumerate((0.0, 220.0)):
         ref = float(printed)
         assert abs(value - ref) <= tolerance(printed), (name, payload, value, printed)
         rows.append({"quantity": name, "m_p (kg)": f"{payload:g}", "uamopt": f"{value:.8g}",
-                     "MODEL_NOTES": printed, "relative difference": f"{abs(value - ref) / abs(ref):.1e}"})
+                     "reference": printed, "relative difference": f"{abs(value - ref) / abs(ref):.1e}"})
 table = (pd.DataFrame(rows).set_index(["quantity", "m_p (kg)"]).unstack("m_p (kg)")
          .swaplevel(axis=1).sort_index(axis=1, level=0, sort_remaining=False).reindex(list(reference)))
 table"""),
@@ -141,16 +139,17 @@ print(f"m_p = {a.payload_kg} kg: A.3 {float(impact_speed(height, k, g)):.8f} m/s
       f"fall time {float(fall_time(height, k, g)):.8f} s, ODE {t_ode:.8f} s")"""),
     md("""## 3 · The risk map
 
-`uamopt.plots.plot_risk` (the `risk.png` of `uamopt risk`) draws (a) $\\log_{10} R$ (Eq. 8) on the
+`uamopt.plotting.risk` (the `risk.png` of `uamopt risk`) returns a matplotlib Figure, shown
+below; `plotting.save(fig, "risk.png")` writes it, and `plotting.risk(field, ax=ax)` draws map (a)
+alone into axes of your own. The page shows (a) $\\log_{10} R$ (Eq. 8) on the
 layer holding the 120 m cruise altitude — the colours jump from blue to yellow at $R_0$, so the
 binary field of Eq. 9 reads directly; buildings reaching the layer are dark grey, no-fly zones
 hatched red; (b) the city: building heights, roads, parks and water; (c) an x–z section through
 V5 with the unsafe free cells outlined and the altitude band of Eq. 14; (d) the mean of each risk
 term per layer; (e) the unsafe share per layer."""),
-    code("""out = Path(tempfile.mkdtemp(prefix="uamopt-nb01-"))
-png = plot_risk(field, out / "risk.png", vertiports=scenario.network.vertiports,
-                cruise_altitude_m=scenario.network.cruise_altitude_m, title=scenario.name)
-display(Image(filename=str(png)))"""),
+    code("""fig = plotting.risk(field, vertiports=scenario.network.vertiports,
+                    cruise_altitude_m=scenario.network.cruise_altitude_m, title=scenario.name)
+fig"""),
     md("""## 4 · Unsafe cells per altitude layer
 
 Eq. 9 marks a cell unsafe for three reasons: it lies inside or below a building (obstacle), in a
@@ -200,6 +199,6 @@ nb = new_notebook(cells=cells, metadata={
     "language_info": {"name": "python"},
 })
 nbformat.validate(nb)
-target = Path("/work/main/notebooks/01_risk_field.ipynb")
+target = Path(__file__).resolve().parent / "01_risk_field.ipynb"
 nbformat.write(nb, target)
 print("wrote", target)

@@ -1,4 +1,4 @@
-"""Shared fixtures: the repository root and small scenarios computed once per session."""
+"""Shared fixtures: the repository root and the paper-case stages, each computed once per session."""
 
 from __future__ import annotations
 
@@ -6,6 +6,8 @@ import os
 from pathlib import Path
 
 import pytest
+
+pytest.register_assert_rewrite("checks", "oracles")
 
 ROOT = Path(__file__).resolve().parents[1]
 PAPER_CASE = ROOT / "models" / "paper_case.toml"
@@ -28,6 +30,23 @@ def paper_run():
 
 
 @pytest.fixture(scope="session")
+def paper_model(paper_run):
+    """The planning model (admissible cells, costs, buffer) of the paper case at 50 × 50 × 30 m."""
+    from uamopt.planning import planning_model
+
+    return planning_model(paper_run.scenario, paper_run.field)
+
+
+@pytest.fixture(scope="session")
+def coarse_run():
+    """The paper case at 100 × 100 × 60 m cells: small enough for graph and figure tests."""
+    from uamopt.scenario import load_scenario
+    from uamopt.stages import compute_risk
+
+    return compute_risk(load_scenario(PAPER_CASE, ["grid.cell=[100,100,60]"]))
+
+
+@pytest.fixture(scope="session")
 def paper_straight_plan():
     """(scenario, grid, straight network, generated plan) of the paper case, seed 0, with Eq. 29
     taken with equality (max_delay_scale = 1, not the calibrated 0.3)."""
@@ -39,6 +58,45 @@ def paper_straight_plan():
     grid = AirspaceGrid.from_extent(scenario.grid.cell, scenario.grid.extent)
     network = straight_network(scenario, grid)
     return scenario, grid, network, generate_plan(scenario, network, seed=0, max_delay_scale=1.0)
+
+
+@pytest.fixture(scope="session")
+def cluster(tmp_path_factory) -> str:
+    """A separately started ``dask scheduler`` and two ``dask worker`` processes on loopback
+    (random free ports); yields the scheduler's address."""
+    import json
+    import subprocess
+    import sys
+    import time
+
+    from distributed import Client
+
+    folder = tmp_path_factory.mktemp("cluster")
+    dask = Path(sys.executable).parent / "dask"
+    scheduler_file = folder / "scheduler.json"
+    quiet = {"stdout": subprocess.DEVNULL, "stderr": subprocess.DEVNULL, "cwd": folder}
+    procs = [subprocess.Popen([str(dask), "scheduler", "--host", "127.0.0.1", "--port", "0", "--no-dashboard",
+                               "--scheduler-file", str(scheduler_file)], **quiet)]
+    try:
+        deadline = time.monotonic() + 60
+        while not scheduler_file.exists() and time.monotonic() < deadline:
+            time.sleep(0.1)
+        address = json.loads(scheduler_file.read_text())["address"]
+        for _ in range(2):
+            procs.append(subprocess.Popen([str(dask), "worker", address, "--nthreads", "1", "--no-dashboard",
+                                           "--host", "127.0.0.1"], **quiet))
+        with Client(address, timeout=30) as client:
+            client.wait_for_workers(2, timeout=120)
+        yield address
+    finally:
+        for p in reversed(procs):
+            p.terminate()
+        for p in procs:
+            try:
+                p.wait(timeout=30)
+            except subprocess.TimeoutExpired:
+                p.kill()
+                p.wait()
 
 
 @pytest.fixture(scope="session")
@@ -68,3 +126,30 @@ def paper_export(paper_schedule_dir, tmp_path_factory):
         return folder
 
     return export
+
+
+@pytest.fixture(scope="session")
+def paper_problem(paper_straight_plan):
+    """The scheduling model of the generated paper-case plan (120 flights, seed 0, straight tracks)."""
+    from uamopt.schedule import build_problem
+
+    scenario, _, _, flights = paper_straight_plan
+    return build_problem(flights, scenario)
+
+
+@pytest.fixture(scope="session")
+def calibrated_problem(paper_straight_plan):
+    """The scheduling model of the calibrated paper-case plan (uamopt/solvers/calibration.py)."""
+    from uamopt.schedule import build_problem
+    from uamopt.solvers.calibration import paper_case_plan
+
+    scenario, _, network, _ = paper_straight_plan
+    return build_problem(paper_case_plan(scenario, network, seed=0), scenario)
+
+
+@pytest.fixture(scope="session")
+def paper_highs(paper_problem):
+    """HiGHS's proven optimum of ``paper_problem`` (a few seconds; solved once per session)."""
+    from uamopt.solvers import SolverProfile, milp
+
+    return milp.solve(paper_problem, SolverProfile("highs", time_limit_s=30.0, threads=2))

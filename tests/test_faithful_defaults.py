@@ -122,3 +122,35 @@ def test_priority_is_refused_by_networkx():
     start, goal = endpoint_cell(model, PAPER_ORIGIN, "origin"), endpoint_cell(model, PAPER_DESTINATION, "destination")
     with pytest.raises(ValueError, match="no open-list priority"):
         grid_search(model.search_problem("initial"), start, goal, backend="networkx")
+
+
+def test_helsinki_route_defaults_to_its_own_vertiports():
+    """The real city's single-track comparison runs between its own vertiports (first and farthest)."""
+    from conftest import ROOT
+
+    origin, destination = default_endpoints(load_scenario(ROOT / "models" / "helsinki.toml"))
+    assert (origin.name, destination.name) == ("Kamppi", "Senaatintori")
+    assert origin.point == (80.0, 585.0, 120.0) and destination.point == (950.0, 595.0, 120.0)
+    chosen = load_scenario(ROOT / "models" / "helsinki.toml", ["tracks.route=['Esplanadi','Kaisaniemi']"])
+    assert [e.name for e in default_endpoints(chosen)] == ["Esplanadi", "Kaisaniemi"]
+
+
+@pytest.mark.slow
+def test_helsinki_reproduce_end_to_end(tmp_path):
+    """`uamopt reproduce models/helsinki.toml` with no --set: every schedule verified, and no paper
+    figure beside the Helsinki instance (measured: about 5 minutes on 2 shared cores)."""
+    import json
+
+    from conftest import ROOT
+    from uamopt.cli import main
+    from uamopt.schedule.verify import verify_dir
+
+    out = tmp_path / "helsinki"
+    assert main(["reproduce", str(ROOT / "models" / "helsinki.toml"), "--out", str(out)]) == 0
+    folders = sorted(p.parent for p in out.glob("schedules/*/*/summary.json"))
+    assert len(folders) == 10
+    for folder in folders:
+        assert verify_dir(folder) == [], folder
+        assert json.loads((folder / "summary.json").read_text())["flights"] == 200
+    report = (out / "report.md").read_text()
+    assert "the paper has no figures for this track" in report and "[196]" not in report and "[109]" not in report

@@ -22,9 +22,8 @@ P_O, P_D = (300.0, 300.0, 120.0), (2220.0, 4220.0, 120.0)
 
 
 @pytest.fixture(scope="module")
-def model(root):
-    s = load_scenario(root / "models" / "paper_case.toml")
-    return planning_model(s, compute_risk(s).field)
+def model(paper_model):
+    return paper_model
 
 
 @pytest.fixture(scope="module")
@@ -33,7 +32,7 @@ def plan(model):
 
 
 def test_transport_cost_of_the_straight_segment_matches_table2():
-    """MODEL_NOTES: m_p ≈ 145.6 kg makes the straight 4365 m level track cost ¥27.15 (±0.5 %)."""
+    """docs/readings.md: m_p ≈ 145.6 kg makes the straight 4365 m level track cost ¥27.15 (±0.5 %)."""
     c_h, _ = transport_rates(Scenario())
     assert load_factor(Scenario()) == pytest.approx(1 + 145.6 / 220 * 1.56)
     assert c_h * 4365.0 == pytest.approx(27.1527, rel=5e-3)

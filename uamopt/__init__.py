@@ -50,6 +50,9 @@ _LAZY = {
     "Schedule": "uamopt.schedule.model", "SolverProfile": "uamopt.solvers",
     "load_risk": "uamopt.io", "load_tracks": "uamopt.io", "load_network": "uamopt.io",
     "load_flights": "uamopt.io", "load_schedule": "uamopt.io",
+    # experiments: not modules of these names, so that importing one never shadows the function
+    "sweep": "uamopt.experiments.engine", "load_sweep": "uamopt.experiments.spec",
+    "plot_sweep": "uamopt.experiments.figures", "benchmark": "uamopt.experiments.benchmark",
 }
 
 __all__ = sorted([*_LAZY, "GridError", "InfeasibleScheduleError", "InputFileError", "NoTrackError",
@@ -61,9 +64,8 @@ def __getattr__(name: str):
         value = getattr(importlib.import_module(_LAZY[name]), name)
         globals()[name] = value
         return value
-    if name in ("plotting", "benchmark", "sweep"):  # a package, or a module's function of that name
-        module = importlib.import_module(f"uamopt.{name}")
-        return getattr(module, name, module)
+    if name == "plotting":  # a package
+        return importlib.import_module(f"uamopt.{name}")
     raise AttributeError(f"module 'uamopt' has no attribute {name!r}")
 
 

@@ -2,7 +2,7 @@
 
 Local metric frame: x east, y north, z altitude above the ground datum, metres. Cell (i, j, k) is
 0-based; its centre is ((i + ½)Δx, (j + ½)Δy, (k + ½)Δz), which is the paper's
-x = (i − ½)Δx with its 1-based i (MODEL_NOTES). The grid holds a = ⌊x_max/Δx⌋ × b × c whole cells.
+x = (i − ½)Δx with its 1-based i (docs/readings.md). The grid holds a = ⌊x_max/Δx⌋ × b × c whole cells.
 """
 
 from __future__ import annotations

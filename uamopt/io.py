@@ -135,7 +135,7 @@ def save_risk(field: RiskField, folder: str | Path) -> None:
 
 
 def save_tracks(plan: TrackPlan, folder: str | Path, scenario=None) -> None:
-    """``tracks.json`` of a plan folder (INTERFACES: stages with waypoints and metrics)."""
+    """``tracks.json`` of a plan folder (docs/interfaces.md: stages with waypoints and metrics)."""
     from uamopt.outputs import write_json
 
     folder = Path(folder)

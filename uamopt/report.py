@@ -13,7 +13,7 @@ from uamopt.risk import (
 )
 from uamopt.scenario import Scenario
 
-# MODEL_NOTES reference numbers (Table B.3, h' = 148.2 m), for m_p = 0 kg and 220 kg.
+# The reference numbers of docs/readings.md (Table B.3, h' = 148.2 m), for m_p = 0 kg and 220 kg.
 REFERENCE = {
     "terminal speed (m/s)": (27.468, 34.198),
     "v from h' = 148.2 m (A.3, m/s)": (27.174496, 32.740228),
@@ -75,7 +75,7 @@ def risk_section(scenario: Scenario, summary: dict) -> str:
         "",
         "### Appendix A reference numbers (h' = 148.2 m, Table B.3)",
         "",
-        "| quantity | ours, m_p = 0 | MODEL_NOTES | ours, m_p = 220 kg | MODEL_NOTES |",
+        "| quantity | ours, m_p = 0 | reference | ours, m_p = 220 kg | reference |",
         "|---|---|---|---|---|",
     ]
     for name, a, ra, b, rb in reference_rows(scenario):
@@ -111,7 +111,7 @@ def _change(value: float, base: float) -> str:
 
 
 def straight_segment_cost(scenario: Scenario, length_m: float = 4365.0) -> float:
-    """Eq. 12 for a straight level segment: c_h · L · c_e · τ(m_p) (MODEL_NOTES: ¥27.15)."""
+    """Eq. 12 for a straight level segment: c_h · L · c_e · τ(m_p) (docs/readings.md: ¥27.15)."""
     from uamopt.planning.problem import transport_rates
 
     return transport_rates(scenario)[0] * length_m

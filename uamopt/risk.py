@@ -1,6 +1,6 @@
 """Operational risk field (Sec. 4.1.1, App. A): Eqs. 1–9 and A.1–A.9, vectorised over every cell.
 
-Readings (MODEL_NOTES):
+Readings (docs/readings.md):
 
 - Each cell is evaluated separately; h' = centre altitude − surface height under it. A cell any
   part of which lies below the surface (inside or under a building) is an obstacle; its
@@ -199,7 +199,7 @@ class RiskField:
         return self.grid.layers_in_band(*self.band)
 
     def arrays(self) -> dict[str, np.ndarray]:
-        """The arrays of ``risk.npz`` (INTERFACES.md)."""
+        """The arrays of ``risk.npz`` (docs/interfaces.md)."""
         g = self.grid
         return {
             "risk": self.risk, "risk_P": self.risk_P, "risk_V": self.risk_V, "risk_U": self.risk_U,
@@ -323,7 +323,7 @@ def risk_field(scenario: Scenario, grid: AirspaceGrid, city: CityLayers) -> Risk
     # One layer at a time: every operation is vectorised over the layer's columns, and the
     # temporaries stay the size of one layer (memory ~ outputs only, even at 5 m cells).
     for k, z in enumerate(grid.z):
-        # h' per cell (MODEL_NOTES); an obstacle is any cell reaching below the surface.
+        # h' per cell (docs/readings.md); an obstacle is any cell reaching below the surface.
         blocked = (z - 0.5 * grid.cell[2]) < city.surface_height - 1e-9
         height = np.where(blocked, np.nan, z - city.surface_height)
         decay = np.exp(-2.0 * c.k_per_m * height)  # e^{-2kh'}, shared by A.3 and the fall time

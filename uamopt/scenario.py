@@ -5,7 +5,7 @@ unit stand beside each field (``description``) and ``uamopt keys`` would list th
 are validated once, here, at the boundary (STYLE.md); the library trusts them afterwards.
 
 Reading: ``load_scenario(path, overrides=["grid.cell=[10,10,10]"])``. Overrides use TOML value
-syntax with dotted keys (INTERFACES.md); a value that is not valid TOML is taken as a string, so
+syntax with dotted keys (docs/interfaces.md); a value that is not valid TOML is taken as a string, so
 ``--set city.source=osm`` works without quotes.
 """
 
@@ -85,7 +85,7 @@ class AircraftConfig(_Section):
     payload_kg: NonNegFloat = Field(
         145.6,
         description="m_p, kg. Table B.3 gives no value; 145.6 kg reproduces Table 2's shortest-track "
-        "cost of ¥27.15 over 4365 m through Eqs. 12-13 (MODEL_NOTES)",
+        "cost of ¥27.15 over 4365 m through Eqs. 12-13 (docs/readings.md)",
     )
     payload_max_kg: PositiveFloat = Field(220.0, description="m_p max, kg")
     mass_max_kg: PositiveFloat = Field(650.0, description="m_max, maximum take-off mass, kg (Eq. 18)")
@@ -146,7 +146,7 @@ class Vertiport(_Section):
 
 
 def _paper_vertiports() -> tuple[Vertiport, ...]:
-    # Table B.3 gives V1..V5 in 10 m grid units (MODEL_NOTES): V1 = (30, 30) is (300 m, 300 m).
+    # Table B.3 gives V1..V5 in 10 m grid units (docs/readings.md): V1 = (30, 30) is (300 m, 300 m).
     pts = {"V1": (30, 30), "V2": (30, 422), "V3": (222, 30), "V4": (222, 422), "V5": (126, 226)}
     return tuple(Vertiport(name=n, x=10.0 * x, y=10.0 * y) for n, (x, y) in pts.items())
 
@@ -304,7 +304,7 @@ class ScheduleConfig(_Section):
 
 
 class Scenario(_Section):
-    """A whole scenario: one TOML file, sections as in INTERFACES.md."""
+    """A whole scenario: one TOML file, sections as in docs/interfaces.md."""
 
     name: str = "scenario"
     description: str = ""

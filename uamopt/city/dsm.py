@@ -1,7 +1,7 @@
 """City layers from a digital surface model (DSM) GeoTIFF, through rasterio.
 
 The DSM must be in a projected CRS in metres (UTM, a national grid). The local frame's (0, 0) is
-the raster's (left, bottom) corner, x east, y north (MODEL_NOTES). Each grid column takes the
+the raster's (left, bottom) corner, x east, y north (docs/readings.md). Each grid column takes the
 maximum DSM value over its footprint (conservative: the column is an obstacle up to its highest
 point), then
 

@@ -1,4 +1,4 @@
-"""Exports of a schedule folder for other tools (INTERFACES.md, docs/export.md).
+"""Exports of a schedule folder for other tools (docs/interfaces.md, docs/export.md).
 
     export_bluesky("out/sched")   # out/sched/bluesky.scn: a BlueSky scenario of the operated flights
     export_geojson("out/sched")   # tracks.geojson, vertiports.geojson, unsafe.geojson in WGS 84

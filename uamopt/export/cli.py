@@ -1,4 +1,4 @@
-"""The ``export`` and ``replay`` subcommands (INTERFACES.md), added to the main parser by one call.
+"""The ``export`` and ``replay`` subcommands (docs/interfaces.md), added to the main parser by one call.
 
     uamopt export bluesky DIR [--dt S] [--bank DEG] [--trajectory designed|waypoints] [--zone RPZ,HPZ]
                               [--budget EH,EV]                                       # DIR/bluesky.scn

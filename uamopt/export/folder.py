@@ -1,6 +1,6 @@
 """Reading a schedule folder (``flights.json``, ``schedule.csv``, ``summary.json``) for the exports.
 
-The folder is what ``uamopt schedule`` writes (INTERFACES.md). The exports need the operated
+The folder is what ``uamopt schedule`` writes (docs/interfaces.md). The exports need the operated
 flights with their departure and arrival times, the tracks, and the georeference (``frame`` in
 summary.json, see :mod:`uamopt.export.frame`).
 """

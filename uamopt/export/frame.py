@@ -1,6 +1,6 @@
 """Where the local metric frame lies on the Earth: the georeference every export uses.
 
-The model works in a local frame (MODEL_NOTES): x east, y north, z altitude above the ground
+The model works in a local frame (docs/readings.md): x east, y north, z altitude above the ground
 datum, metres. A :class:`LocalFrame` ties it to a projected CRS: local (x, y) = CRS (E − E₀, N − N₀)
 with (E₀, N₀) = ``origin``, the CRS coordinates of the local (0, 0). Per city source:
 

@@ -15,7 +15,7 @@ solves with the weights normal to the segment ab, ω4 ∝ C_T(b) − C_T(a), ω5
 keeps splitting wherever a new point appears. Without the buffer (``buffer=False``) this finds
 the supported points of the exact bi-objective front; with it, each point is still the optimum
 of its own weighted search, and the points that the buffer term makes dominated are reported
-as such by :func:`non_dominated` and greyed by :func:`plot_pareto`.
+as such by :func:`non_dominated` and greyed by :func:`uamopt.plotting.pareto`.
 """
 
 from __future__ import annotations
@@ -24,15 +24,13 @@ import dataclasses
 import heapq
 from collections.abc import Sequence
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
-from matplotlib.figure import Figure
 
 from uamopt.planning.endpoints import as_endpoint
 from uamopt.planning.problem import PlanningModel
 from uamopt.planning.search import grid_search
-from uamopt.planning.tracks import STAGES, TrackPlan, endpoint_cell, track_metrics
+from uamopt.planning.tracks import endpoint_cell, track_metrics
 
 TIE_BREAK = 1e-6  # ε: a zero weight becomes ε times the other objective's per-metre scale
 SAME_COST = 1e-9  # relative tolerance under which two points have the same costs
@@ -184,57 +182,18 @@ def pareto_front(model: PlanningModel, origin, destination, weights: int | Seque
 
     Examples
     --------
-    >>> front = pareto_front(model, (300, 300, 120), (2220, 4220, 120), 9)  # doctest: +SKIP
-    >>> [(round(p.transport_cost, 2), round(p.risk_cost)) for p in front]  # doctest: +SKIP
+    Table B.3's synthetic city on 100 m cells, V1 → V4 at 120 m:
+
+    >>> from uamopt.planning import planning_model
+    >>> from uamopt.scenario import Scenario
+    >>> from uamopt.stages import compute_risk
+    >>> scenario = Scenario().with_overrides(["grid.cell=[100,100,60]"])
+    >>> model = planning_model(scenario, compute_risk(scenario).field)
+    >>> front = pareto_front(model, (300, 300, 120), (2220, 4220, 120), 5, buffer=False)
+    >>> [(round(p.risk_cost), round(p.transport_cost, 2)) for p in front]
+    [(3068, 29.15), (2985, 29.52), (2902, 30.25), (2861, 30.61), (2744, 97.11)]
+    >>> with_buffer = pareto_front(model, (300, 300, 120), (2220, 4220, 120), 5)  # plus μ·R(t), Eq. 34
+    >>> [(round(p.risk_cost), round(p.transport_cost, 2)) for p in with_buffer]
+    [(3206, 99.08), (3002, 99.81), (2961, 100.18)]
     """
     return non_dominated(weight_sweep(model, origin, destination, weights, buffer=buffer))
-
-
-def plot_pareto(points: Sequence[ParetoPoint], path: str | Path, *, plan: TrackPlan | None = None,
-                title: str = "") -> Path:
-    """Draw the trade-off of Fig. 21 and write an 8 × 5.5 in PNG at 130 dpi.
-
-    ``points`` may hold a whole :func:`weight_sweep`: the non-dominated ones form the front
-    (line and markers, each labelled with its (ω4, ω5)), the others are greyed. With ``plan``, its four
-    stages (Table 2) are marked in the colours of Fig. 18 for comparison.
-    """
-    from uamopt.plot_tracks import STAGE_STYLE  # the stage colours; a plotting import, kept local
-    from uamopt.plots import DPI
-
-    path = Path(path)
-    if not points:
-        raise ValueError("points must hold at least one ParetoPoint")
-    front = non_dominated(points)
-    on_front = {id(p) for p in front}
-    rest = [p for p in points if id(p) not in on_front]
-    fig = Figure(figsize=(8.0, 5.5), dpi=DPI, layout="constrained")
-    ax = fig.add_subplot()
-    if rest:
-        ax.scatter([p.transport_cost for p in rest], [p.risk_cost for p in rest], s=28, c="0.7",
-                   edgecolors="0.45", linewidths=0.6, zorder=3, label="dominated")
-    ax.plot([p.transport_cost for p in front], [p.risk_cost for p in front], color="#1f4e9c", lw=1.4,
-            marker="o", ms=6, mfc="white", mew=1.4, zorder=4,
-            label=f"Pareto front ({len(front)} track{'s' if len(front) > 1 else ''})")
-    if plan is not None:
-        for name, marker in zip(STAGES, "sDPo"):
-            st = plan.stages[name]
-            ax.scatter([st.transport_cost], [st.risk_cost], marker=marker, s=55, c=STAGE_STYLE[name][1],
-                       edgecolors="black", linewidths=0.7, zorder=5, label=f"{name} track (Table 2)")
-    ax.margins(x=0.12, y=0.08)
-    ax.autoscale_view()
-    middle = 0.5 * sum(ax.get_xlim())
-    for p in front:  # labels point inwards, away from the axes' edges
-        left = p.transport_cost > middle
-        ax.annotate(f"(ω4, ω5) = ({p.w4:.2g}, {p.w5:.2g})", (p.transport_cost, p.risk_cost),
-                    xytext=(-7 if left else 7, 0), textcoords="offset points", fontsize=6.5, color="#1f4e9c",
-                    va="center", ha="right" if left else "left", zorder=6)
-    ax.set_xlabel("transport cost C_T (¥, Eq. 12)", fontsize=9)
-    ax.set_ylabel("operational risk cost C_R (Eq. 11)", fontsize=9)
-    ax.tick_params(labelsize=8)
-    ax.grid(color="0.9", lw=0.6)
-    ax.legend(fontsize=7.5, loc="best", framealpha=0.9)
-    head = f"{title} — " if title else ""
-    ax.set_title(f"{head}trade-off between operational risk and transport cost (Fig. 21)", fontsize=10)
-    fig.savefig(path, dpi=DPI)
-    fig.clear()
-    return path

@@ -1,6 +1,6 @@
 """The single-aircraft track planning model (Sec. 4.2, 5.1): admissible cells, costs, buffer.
 
-Readings (MODEL_NOTES, paper Sec. 5.1):
+Readings (docs/readings.md, paper Sec. 5.1):
 
 - Admissible cells: passable (not an obstacle, not a no-fly zone; Eq. 9/15), centre altitude in
   the band of Eq. 14, and centre at least s_min from the centre of every *building* cell (Eq. 15).

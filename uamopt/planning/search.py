@@ -1,6 +1,6 @@
 """Optimal grid search for the track planner: four backends that must agree on the optimal cost.
 
-The move n → m between 26-neighbour cells (MODEL_NOTES) costs
+The move n → m between 26-neighbour cells (docs/readings.md) costs
 
     w_risk · ½(R_n + R_m) · d  +  c_h' · horizontal  +  c_v' · |vertical|  +  penalty_m
 

@@ -37,7 +37,7 @@ STAGES = ("shortest", "initial", "equivalent", "optimal")
 
 @dataclass(frozen=True)
 class TrackStage:
-    """One stage's track and its metrics (INTERFACES.md ``tracks.json``)."""
+    """One stage's track and its metrics (docs/interfaces.md ``tracks.json``)."""
 
     name: str
     waypoints: np.ndarray  # (n, 3), m

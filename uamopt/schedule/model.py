@@ -5,7 +5,7 @@ paper: per flight its planned departure D, flight time, delay bound, turnaround 
 predecessors; per conflicting pair the forbidden open intervals of δ = dep_q − dep_p; the
 objective. Decisions: c_f ∈ {0, 1} (operated) and 0 ≤ d_f ≤ ``delay_upper_s[f]``; dep_f = D_f + d_f.
 
-Constraints (MODEL_NOTES, Scheduling):
+Constraints (docs/readings.md, Scheduling):
 
 1. Conflicts: for each pair (p, q, intervals) of ``conflicts`` with c_p = c_q = 1,
    dep_q − dep_p ∉ (lo, hi) for every row — i.e. δ ≤ lo or δ ≥ hi.
@@ -116,7 +116,7 @@ def build_problem(
     """Compute the pair conflicts of ``flightset`` and assemble the model.
 
     ``weights`` default to the scenario's (ω6, ω7) = (0.6, 0.4); G defaults to the number of
-    distinct aircraft in the flight set (INTERFACES.md); ΔT_a is ``schedule.time_step_s``.
+    distinct aircraft in the flight set (docs/interfaces.md); ΔT_a is ``schedule.time_step_s``.
     """
     if weights is None:
         weights = tuple(scenario.schedule.weights) if scenario is not None else (0.6, 0.4)  # type: ignore[assignment]
@@ -222,7 +222,7 @@ class Schedule:
         return frame.set_index("flight")
 
     def summary(self) -> dict:
-        """The keys of summary.json (INTERFACES.md)."""
+        """The keys of summary.json (docs/interfaces.md)."""
         return {
             "solver": self.solver, "status": self.status, "objective": self.objective, "bound": self.bound,
             "gap": self.gap, "operated": self.operated_count, "cancelled": self.cancelled,
@@ -256,7 +256,7 @@ def write_schedule(out_dir: str | Path, problem: SchedulingProblem, schedule: Sc
 
     ``schedule.csv``: flight, aircraft, route, operated (1/0), planned_departure_s, delay_s,
     departure_s, arrival_s; a cancelled flight has delay 0 and empty departure and arrival.
-    ``summary.json`` carries the INTERFACES.md keys plus ``weights``, ``objective_kind``,
+    ``summary.json`` carries the docs/interfaces.md keys plus ``weights``, ``objective_kind``,
     ``aircraft`` (G) and ``flights`` so the verifier can recompute the objective; ``extra`` adds
     keys (``uamopt schedule`` adds ``frame`` and ``scenario`` for the exports, uamopt.export.frame).
     """

@@ -1,7 +1,7 @@
 """The independent verifier behind ``uamopt verify DIR``.
 
 It reads ``DIR/flights.json`` and ``DIR/schedule.csv`` (and ``DIR/summary.json`` when present)
-and checks the schedule against the rules of MODEL_NOTES, sharing no code with the model: its own
+and checks the schedule against the rules of docs/readings.md, sharing no code with the model: its own
 file reading (json, csv), its own occupancy by a different algorithm (a 3-D digital differential
 analyser that walks each segment cell by cell in plain Python, Amanatides & Woo 1987, instead of
 the model's vectorised sort of all plane-crossing times) and its own conflict search (a hash of

@@ -1,6 +1,6 @@
 """BlueSky's protected zone derived from our cell-based conflict zone, and why it is sound.
 
-Our model (Sec. 5.2.1, MODEL_NOTES): two operated flights conflict when, at overlapping times,
+Our model (Sec. 5.2.1, docs/readings.md): two operated flights conflict when, at overlapping times,
 they occupy cells whose indices differ by at most r in every axis. BlueSky's zone is metric: a
 loss of separation (LoS) is horizontal distance < r_pz and |Δalt| < h_pz.
 

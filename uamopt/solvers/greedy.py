@@ -11,7 +11,7 @@ Fig. 13) — it is delayed past the interval's end (Fig. 12). Delays are whole m
 ΔT_a (``step_s``, Table B.3: 10 s), so a delay is rounded *up* to the step; with ``exact_gaps``
 the flight goes exactly to the gap's end instead. When the delay needed exceeds the flight's
 threshold, min(Δd_f, T_f − A_f) (Eqs. 26, 29), the flight is cancelled; a cancelled outbound
-cancels its return (MODEL_NOTES: the aircraft never left). The result is feasible by construction.
+cancels its return (docs/readings.md: the aircraft never left). The result is feasible by construction.
 
 Decoder (shared with :mod:`uamopt.solvers.genetic`)
 ---------------------------------------------------

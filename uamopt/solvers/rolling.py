@@ -46,13 +46,10 @@ the feasibility tolerance. Lexicographic: the same with −1 per flight and dist
 
 Options (``[options]`` of a profile): ``window_s`` (900), ``inner`` ("cpsat"), ``window_time_limit_s``
 (default ``time_limit_s`` / number of non-empty windows), ``time_unit_s`` (CP-SAT, 0.01),
-``step_s`` (greedy fallback ΔT_a; default the problem's ``schedule.time_step_s``). Status: ``feasible``, or ``time_limit`` if some window's
-inner solve stopped at its limit without proof. Registry line (``SOLVERS`` in __init__.py)::
-
-    "rolling": "uamopt.solvers.rolling",
-
-Until registered, call the module directly with any valid profile:
-``rolling.solve(problem, SolverProfile("cpsat", time_limit_s=60, options={"inner": "cpsat"}))``.
+``step_s`` (greedy fallback ΔT_a; default the problem's ``schedule.time_step_s``). Status: ``feasible``, or
+``time_limit`` if some window's inner solve stopped at its limit without proof. Registered as
+``"rolling"`` (profile ``solvers/rolling.toml``): ``solve(problem, "rolling")``, or
+``solve(problem, SolverProfile("rolling", time_limit_s=60, options={"window_s": 600.0}))``.
 """
 
 from __future__ import annotations

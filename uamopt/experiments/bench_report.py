@@ -1,0 +1,159 @@
+"""``bench.csv``, ``bench.md`` and the performance profile of a benchmark table (benchmark.py).
+
+bench.md: the instances with their best known objective (the least objective of any verified run)
+and the profiles that found it; per instance and profile the runs, how many verified, the statuses, the objective's
+median and range over the seeds, its distance to the best known (median − best) / |best|, the
+median gap and the times; then every run. With several instances, a Dolan–Moré performance
+profile (``performance_profile.png``): for each profile the fraction of instances on which its
+median objective lies within a factor τ of the best profile's, with the ratio taken on the
+objective's distance to the best, r = 1 + (obj − best) / |best| (the objectives of Eq. 20 are
+negative, so a plain quotient would not order them); a run without a solution has r = ∞.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from pathlib import Path
+
+import numpy as np
+
+
+def _num(value, digits: int = 6) -> str:
+    if value is None or (isinstance(value, float) and not math.isfinite(value)):
+        return "-"
+    if isinstance(value, (float, np.floating)):
+        return f"{value:.{digits}g}"
+    return str(value)
+
+
+def _markdown(frame, columns: list[str]) -> list[str]:
+    lines = ["| " + " | ".join(columns) + " |", "|" + "---|" * len(columns)]
+    lines += ["| " + " | ".join(_num(v) for v in row) + " |" for row in frame[columns].itertuples(index=False)]
+    return lines
+
+
+def best_known(table):
+    """Per instance: the least objective of a verified run with a solution, and the profiles
+    that reached it (within a relative 1e-9)."""
+    ok = table[table["verified"].fillna(False).astype(bool) & table["objective"].notna()]
+    best = ok.groupby("instance", sort=False)["objective"].min()
+    found_by = {i: ", ".join(dict.fromkeys(ok[(ok["instance"] == i) & (ok["objective"] <= b + 1e-9 * max(1.0, abs(b)))]["profile"]))
+                for i, b in best.items()}
+    return best, found_by
+
+
+def distance(value: float, best: float) -> float:
+    """(value − best) / |best|; 0 at the best, NaN without a value or reference."""
+    if not (math.isfinite(value) and math.isfinite(best)):
+        return math.nan
+    return (value - best) / abs(best) if best != 0 else (0.0 if value == best else math.inf)
+
+
+def summary(table):
+    """One row per instance × profile: medians and ranges over the seeds (see the module docstring)."""
+    import pandas as pd
+
+    best, _ = best_known(table)
+    rows = []
+    for (instance, profile), runs in table.groupby(["instance", "profile"], sort=False):
+        obj = runs["objective"].dropna()
+        median = float(obj.median()) if len(obj) else math.nan
+        statuses = runs["status"].value_counts()
+        rows.append({
+            "instance": instance, "profile": profile, "runs": len(runs),
+            "verified": f"{int(runs['verified'].fillna(False).astype(bool).sum())}/{len(runs)}",
+            "status": ", ".join(f"{s} ×{n}" for s, n in statuses.items()),
+            "objective median": median,
+            "objective range": f"{_num(obj.min())} – {_num(obj.max())}" if len(obj) else "-",
+            "to best known %": 100.0 * distance(median, best.get(instance, math.nan)),
+            "gap median": float(runs["gap"].median()) if runs["gap"].notna().any() else math.nan,
+            "wall s median": float(runs["wall_seconds"].median()),
+            "wall s max": float(runs["wall_seconds"].max()),
+            "solve s median": float(runs["solve_seconds"].median()) if runs["solve_seconds"].notna().any() else math.nan,
+            "build s median": float(runs["build_seconds"].median()) if runs["build_seconds"].notna().any() else math.nan,
+        })
+    return pd.DataFrame(rows)
+
+
+def performance_ratios(table):
+    """instance × profile matrix of r = 1 + (median obj − best median) / |best median| (∞: no solution)."""
+    medians = table.groupby(["instance", "profile"], sort=False)["objective"].median().unstack("profile")
+    best = medians.min(axis=1)
+    ratios = medians.copy()
+    for instance in medians.index:
+        for profile in medians.columns:
+            d = distance(medians.loc[instance, profile], best[instance])
+            ratios.loc[instance, profile] = math.inf if math.isnan(d) else 1.0 + d
+    return ratios.astype(float)
+
+
+def plot_performance_profile(table, path: str | Path | None = None, ax=None):
+    """Dolan–Moré profile: fraction of instances with ratio ≤ τ, one step line per profile."""
+    from matplotlib.figure import Figure
+
+    ratios = performance_ratios(table)
+    finite = ratios.to_numpy()[np.isfinite(ratios.to_numpy())]
+    tau_max = max(1.05, float(finite.max()) * 1.05 if finite.size else 2.0)
+    if ax is None:
+        fig = Figure(figsize=(6.5, 4.2), dpi=130)
+        ax = fig.add_subplot(1, 1, 1)
+    fig = ax.figure
+    n = len(ratios)
+    for profile in ratios.columns:
+        r = np.sort(ratios[profile].to_numpy())
+        taus = np.concatenate([[1.0], r[np.isfinite(r)], [tau_max]])
+        share = [np.sum(r <= t) / n for t in taus]
+        ax.step(taus, share, where="post", label=profile, linewidth=1.6)
+    ax.set_xlim(1.0, tau_max)
+    ax.set_ylim(0.0, 1.02)
+    ax.set_xlabel("τ (ratio to the best objective, 1 + distance)")
+    ax.set_ylabel("fraction of instances within τ")
+    ax.set_title(f"Performance profile over {n} instances (median over seeds)")
+    ax.grid(alpha=0.3)
+    ax.legend(loc="lower right")
+    if path is not None:
+        fig.savefig(path, bbox_inches="tight")
+    return fig
+
+
+def bench_markdown(table) -> str:
+    best, found_by = best_known(table)
+    instances = table.drop_duplicates("instance")[["instance", "flights", "aircraft", "conflicting_pairs"]].copy()
+    instances["best known objective"] = [best.get(i, math.nan) for i in instances["instance"]]
+    instances["found by"] = [found_by.get(i, "-") for i in instances["instance"]]
+    limits = sorted({_num(v) for v in table["time_limit_s"]})
+    load = ", ".join(f"{v:.2f}" for v in os.getloadavg()) if hasattr(os, "getloadavg") else "n/a"
+    lines = ["# Benchmark", "",
+             f"{len(table)} runs: {table['instance'].nunique()} instances × {table['profile'].nunique()} profiles × "
+             f"seeds {sorted(set(table['seed']))}; time limit {', '.join(limits)} s; objective "
+             f"{', '.join(sorted(set(table['objective_kind'])))}; {os.cpu_count()} CPUs, load average {load} at the end.",
+             "", "## Instances", ""] + _markdown(instances, list(instances.columns))
+    lines += ["", "## By solver profile (median and range over seeds)", "",
+              "`to best known %` = 100 (median objective − best known) / |best known|; `gap` = |objective − bound| / |objective| "
+              "as the solver reports its bound (empty where undefined); `solve s` is the solver's own clock, which the "
+              "time limit bounds, `build s` the rest of the wall time (model building, data transfer). Each solver ran "
+              "once untimed on a few flights first (imports, helper processes).", ""]
+    lines += _markdown(summary(table), ["instance", "profile", "runs", "verified", "status", "objective median",
+                                        "objective range", "to best known %", "gap median", "wall s median", "wall s max",
+                                        "solve s median", "build s median"])
+    if table["instance"].nunique() > 1:
+        lines += ["", "## Performance profile", "", "![performance profile](performance_profile.png)"]
+    lines += ["", "## Runs", ""] + _markdown(table, [c for c in table.columns if c not in ("error", "objective_kind")])
+    errors = table[table["error"].notna()]
+    if len(errors):
+        lines += ["", "## Errors", ""] + [f"- {r.instance} {r.profile} seed {r.seed}: {r.error}" for r in errors.itertuples()]
+    return "\n".join(lines) + "\n"
+
+
+def write_bench(out: str | Path, table) -> str:
+    """Write bench.csv, bench.md (and performance_profile.png) into ``out``, all or nothing."""
+    from uamopt.outputs import staged_output
+
+    text = bench_markdown(table)
+    with staged_output(out) as stage:
+        table.to_csv(stage / "bench.csv", index=False, na_rep="")
+        (stage / "bench.md").write_text(text, encoding="utf-8")
+        if table["instance"].nunique() > 1:
+            plot_performance_profile(table, stage / "performance_profile.png")
+    return text

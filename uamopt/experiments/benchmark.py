@@ -1,0 +1,211 @@
+"""Solver benchmarks: ``uamopt bench`` and :func:`benchmark` (a loop, not a special case: every
+solver takes the same :class:`~uamopt.schedule.SchedulingProblem` and returns a Schedule).
+
+One row per instance × profile × seed (``COLUMNS``): the instance's name and size (flights,
+aircraft G, conflicting pairs), the profile, its solver, seed, threads and the time limit it was
+given, the objective kind (Eq. 20 ``weighted`` or ``lexicographic``), the solver's status,
+objective, bound and relative gap (NaN where undefined: no incumbent, no bound, or an objective
+of 0), operated S (Eq. 22), cancelled, total and average delay (Eq. 21), and three times:
+``wall_seconds`` around the whole call, ``solve_seconds`` as the solver reports it (HiGHS's and
+CP-SAT's own clocks, which the time limit bounds) and ``build_seconds`` = wall − solve (model
+building, data transfer). Before the timed runs each solver runs once, untimed, on a few flights
+(:func:`warm_up`), so no row carries a process's one-time costs (imports, helper processes).
+``verified`` is the independent verifier's verdict on the written schedule
+(uamopt/schedule/verify.py), for every row.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+from pathlib import Path
+
+from uamopt.errors import UamoptError
+from uamopt.experiments.case import error_line, schedule_row, scheduling_problem
+from uamopt.experiments.progress import Progress
+
+COLUMNS = ["instance", "flights", "aircraft", "conflicting_pairs", "solver", "profile", "seed", "threads", "time_limit_s",
+           "objective_kind", "status", "objective", "bound", "gap", "operated", "cancelled", "total_delay_s",
+           "avg_delay_s", "wall_seconds", "solve_seconds", "build_seconds", "verified", "error"]
+
+
+def instance_name(scenario, overrides=()) -> str:
+    """The scenario's name and the overrides that made the instance: ``paper_case[schedule.aircraft=10]``."""
+    return f"{scenario.name}[{','.join(overrides)}]" if overrides else scenario.name
+
+
+def scenario_problem(scenario, seed: int = 0):
+    """The scenario's scheduling instance: its route network planned (Sec. 6.2) and its generated
+    flight plan (plan seed ``schedule.plan_seed + seed``)."""
+    from uamopt.pipeline import compute_risk, plan_network, planning_model
+
+    return scheduling_problem(scenario, plan_network(planning_model(scenario, compute_risk(scenario))), seed)
+
+
+def _instances(problem_or_scenarios) -> dict:
+    """name -> SchedulingProblem from a problem, a scenario (object or file), or a list / dict of them."""
+    from uamopt.scenario import Scenario, load_scenario
+    from uamopt.schedule import SchedulingProblem
+
+    items = problem_or_scenarios
+    if isinstance(items, dict):
+        named = list(items.items())
+    else:
+        items = list(items) if isinstance(items, (list, tuple)) else [items]
+        named = [(None, item) for item in items]
+    out: dict = {}
+    for i, (name, item) in enumerate(named):
+        if isinstance(item, (str, Path)):
+            item = load_scenario(item)
+        if isinstance(item, Scenario):
+            name, item = name or instance_name(item), scenario_problem(item)
+        if not isinstance(item, SchedulingProblem):
+            raise UamoptError(f"cannot benchmark a {type(item).__name__}", "benchmark",
+                              "give SchedulingProblems, Scenarios or scenario files")
+        name = name or f"instance{i + 1}"
+        if name in out:
+            name = f"{name}#{i + 1}"
+        out[name] = item
+    return out
+
+
+def _profiles(solvers, time_limit_s):
+    from uamopt.solvers import SolverProfile, load_profile
+
+    profiles = [s if isinstance(s, SolverProfile) else load_profile(s)
+                for s in ([solvers] if isinstance(solvers, (str, Path)) else solvers)]
+    if time_limit_s is not None:
+        if not (isinstance(time_limit_s, (int, float)) and math.isfinite(time_limit_s) and time_limit_s > 0):
+            raise UamoptError(f"the time limit must be a positive number of seconds, got {time_limit_s!r}", "--time-limit",
+                              "give seconds, e.g. 20")
+        profiles = [dataclasses.replace(p, time_limit_s=float(time_limit_s)) for p in profiles]
+    return profiles
+
+
+def warm_up(problems, profiles) -> None:
+    """Run each solver once, untimed, on the first aircraft's flights of an instance: the one-time
+    costs of a process (imports, HiGHS or OR-Tools helper processes) then stay out of the rows."""
+    from uamopt.pipeline import build_problem, solve
+
+    problem = next(iter(problems))
+    first = problem.flights.flights[0].aircraft
+    tiny = dataclasses.replace(problem.flights, flights=tuple(f for f in problem.flights.flights if f.aircraft == first))
+    tiny_problem = build_problem(tiny, objective=problem.objective_kind, weights=problem.weights)
+    for profile in {p.solver: p for p in profiles}.values():
+        try:
+            solve(tiny_problem, profile, time_limit_s=min(5.0, profile.time_limit_s))
+        except Exception:  # noqa: BLE001 - a broken solver shows in its own rows
+            pass
+
+
+def solve_row(name: str, problem, profile, seed: int) -> dict:
+    """One benchmark row: solve, time, verify; a solver failure is an ``error`` row."""
+    from uamopt.pipeline import solve
+
+    row = {"instance": name, "flights": problem.n_flights, "aircraft": problem.aircraft_count,
+           "conflicting_pairs": len(problem.conflicts), "solver": profile.solver, "profile": profile.name or profile.solver,
+           "seed": seed, "threads": profile.threads, "time_limit_s": profile.time_limit_s,
+           "objective_kind": problem.objective_kind}
+    t0 = time.perf_counter()
+    try:
+        schedule = solve(problem, profile, seed=seed)
+        wall = time.perf_counter() - t0
+        row.update(schedule_row(problem, schedule, wall))
+        row.update(wall_seconds=wall, solve_seconds=schedule.solve_seconds,
+                   build_seconds=max(0.0, wall - schedule.solve_seconds))
+    except Exception as exc:  # noqa: BLE001 - one failing solver must not end a benchmark
+        row.update(status="error", error=error_line(exc), wall_seconds=time.perf_counter() - t0)
+    row.pop("seconds", None)
+    return row
+
+
+def benchmark(problem_or_scenarios, solvers, seeds=None, time_limit_s: float | None = None, *, progress: bool = True):
+    """Run every solver profile with every seed on every instance; one row per run (``COLUMNS``).
+
+    Parameters
+    ----------
+    problem_or_scenarios : SchedulingProblem, Scenario, path, or a list or dict (name -> item) of them
+        A scenario is turned into its instance (network planned, flights generated).
+    solvers : sequence of str, Path or SolverProfile
+        Profiles (``"highs"``, ``"solvers/soa.toml"``).
+    seeds : sequence of int, optional
+        Solver seeds (each profile's own seed when omitted).
+    time_limit_s : float, optional
+        Applied to every profile instead of its own ``time_limit_s``.
+    progress : bool
+        A bar on a terminal, else a line per finished solve on stderr.
+
+    Returns
+    -------
+    pandas.DataFrame
+
+    Examples
+    --------
+    ::
+
+        table = benchmark("models/paper_case.toml", ["greedy", "soa", "highs"], seeds=[0, 1, 2], time_limit_s=30)
+        table.groupby("profile")["objective"].median()
+    """
+    import pandas as pd
+
+    profiles = _profiles(solvers, time_limit_s)
+    instances = _instances(problem_or_scenarios)
+    runs = [(name, p, s) for name in instances for p in profiles for s in (seeds if seeds is not None else [p.seed])]
+    warm_up(instances.values(), profiles)
+    rows = []
+    bar = Progress(len(runs), "bench", "solves", every=True, stream=None) if progress else None
+    for name, profile, seed in runs:
+        row = solve_row(name, instances[name], profile, int(seed))
+        rows.append(row)
+        if bar is not None:
+            objective = row.get("objective")
+            shown = f"{objective:.6g}" if isinstance(objective, float) and math.isfinite(objective) else "-"
+            bar.update(1, f"{name} {row['profile']} seed {seed}: {row['status']} {shown} in {row['wall_seconds']:.1f} s")
+    if bar is not None:
+        bar.close()
+    table = pd.DataFrame.from_records(rows, columns=COLUMNS)
+    for column in ("objective", "bound", "gap", "total_delay_s", "avg_delay_s", "wall_seconds", "solve_seconds", "build_seconds"):
+        table[column] = table[column].astype("float64")
+    return table
+
+
+def cmd_bench(args) -> int:
+    """``uamopt bench``: the instances of the scenarios (or --flights), every profile × seed."""
+    from uamopt.experiments.bench_report import write_bench
+    from uamopt.outputs import check_out_dir
+    from uamopt.scenario import load_scenario
+
+    seeds = None
+    if args.seeds:
+        seeds = list(range(args.seeds[0])) if len(args.seeds) == 1 else list(args.seeds)
+        if not seeds or len(set(seeds)) != len(seeds):
+            raise UamoptError(f"--seeds {' '.join(map(str, args.seeds))} gives no distinct seeds", "--seeds",
+                              "give a count (--seeds 3 runs seeds 0, 1, 2) or two or more seeds (--seeds 0 1 2)")
+    profiles = _profiles(args.solver, args.time_limit)
+    scenarios = [load_scenario(path, args.set) for path in args.scenario]
+    check_out_dir(args.out)
+    instances = {}
+    for scenario in scenarios:
+        name = instance_name(scenario, args.set)
+        instances[name if name not in instances else f"{name}#{len(instances) + 1}"] = _cli_problem(scenario, args)
+    table = benchmark(instances, profiles, seeds=seeds)
+    text = write_bench(args.out, table)
+    print(text)
+    return 0 if bool(table["verified"].fillna(False).all()) else 1
+
+
+def _cli_problem(scenario, args):
+    """--flights (self-contained or on --network routes), else the generated plan (--seed)."""
+    from uamopt.grid import build_grid
+    from uamopt.planning.network import load_network
+    from uamopt.schedule import build_problem, load_flights
+
+    seed = 0 if args.seed is None else args.seed - scenario.schedule.plan_seed
+    if not args.flights:
+        if args.network:
+            return scheduling_problem(scenario, load_network(args.network), seed)
+        return scenario_problem(scenario, seed)
+    network = load_network(args.network) if args.network else None
+    flights = load_flights(args.flights, scenario, build_grid(scenario), network)
+    return build_problem(flights, scenario, objective=scenario.schedule.objective)

@@ -1,0 +1,274 @@
+"""Sweep files (``models/variants/*.toml``): a base scenario, fixed overrides and a grid of cases.
+
+::
+
+    base = "../paper_case.toml"          # scenario, relative to this file
+    stage = "schedule"                   # how far each case runs: risk | plan | network | schedule
+    solvers = ["greedy", "soa", "highs"] # profiles (names or paths), stage = "schedule" only
+    seeds = [0, 1, 2]                    # solver seeds; the plan seed is schedule.plan_seed + seed
+    time_limit_s = 30.0                  # optional: every solver's time limit
+    figure = "flights"                   # optional: the figure drawn from the results (figures.py)
+    [set]                                # fixed overrides, any scenario key
+    "grid.cell" = [50.0, 50.0, 30.0]
+    [grid]                               # the cartesian product of these lists is the set of cases
+    "schedule.flights" = [60, 120, 180, 240]
+    [small]                              # what --small changes: seeds, solvers, time_limit_s,
+    seeds = [0]                          # [small.set] merged into [set], [small.grid] lists
+    [small.grid]                         # replacing (or adding) [grid] lists
+    "schedule.flights" = [60, 120]
+
+Everything is validated here, before any case runs: unknown keys (of the file and of the
+scenario), an empty grid, every case's scenario (:func:`load_sweep` builds each one), the solver
+profiles. A case's id is a hash of all its overrides, fixed and swept, so it is stable across runs
+and machines.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import itertools
+import json
+import math
+import tomllib
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import Any
+
+from uamopt.errors import ScenarioError, UamoptError
+
+STAGES = ("risk", "plan", "network", "schedule")
+FILE_KEYS = {"base", "stage", "solvers", "seeds", "time_limit_s", "figure", "name", "description", "set", "grid", "small"}
+SMALL_KEYS = {"solvers", "seeds", "time_limit_s", "set", "grid"}
+
+
+@dataclass(frozen=True)
+class Case:
+    """One point of the grid: its position, stable id, swept values and the scenario they give."""
+
+    index: int
+    id: str
+    values: dict  # swept key -> value (as written in the file)
+    overrides: tuple[str, ...]  # KEY=VALUE, fixed then swept
+    scenario: Any  # uamopt.scenario.Scenario
+
+
+@dataclass(frozen=True)
+class SweepSpec:
+    """A parsed and validated sweep file."""
+
+    path: Path
+    name: str
+    base: Path
+    stage: str
+    solvers: tuple  # SolverProfile, time limit applied
+    seeds: tuple[int, ...]
+    fixed: dict  # key -> value of [set]
+    grid: dict  # key -> list of values
+    cases: tuple[Case, ...]
+    time_limit_s: float | None = None
+    figure: str | None = None
+    small: bool = False
+
+    @property
+    def swept_keys(self) -> list[str]:
+        return list(self.grid)
+
+    def row_keys(self) -> list[tuple]:
+        """(case id, solver, seed) of every row the sweep must hold, in table order."""
+        if self.stage != "schedule":
+            return [(c.id, None, None) for c in self.cases]
+        return [(c.id, p.name, s) for c in self.cases for p in self.solvers for s in self.seeds]
+
+    def manifest(self) -> dict:
+        """What a results folder records of its sweep; a resumed run must agree on all of it."""
+        return {
+            "uamopt_sweep": 1, "name": self.name, "base_sha256": hashlib.sha256(self.base.read_bytes()).hexdigest(),
+            "stage": self.stage, "small": self.small, "set": {k: toml_value(v) for k, v in sorted(self.fixed.items())},
+            "solvers": {p.name: _profile_text(p) for p in self.solvers},
+        }
+
+
+def toml_value(value: Any) -> str:
+    """``value`` written as a TOML value (the syntax of ``--set KEY=VALUE``)."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, int):
+        return str(value)
+    if isinstance(value, float):
+        if math.isnan(value):
+            return "nan"
+        return repr(value) if math.isfinite(value) else ("inf" if value > 0 else "-inf")
+    if isinstance(value, str):
+        return json.dumps(value, ensure_ascii=False)
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(toml_value(v) for v in value) + "]"
+    if isinstance(value, dict):
+        return "{" + ", ".join(f"{json.dumps(str(k))} = {toml_value(v)}" for k, v in value.items()) + "}"
+    raise TypeError(f"no TOML form for {value!r}")
+
+
+def case_id(overrides: list[str] | tuple[str, ...]) -> str:
+    """A stable 12-hex-digit id of a case from its overrides (order-independent)."""
+    return hashlib.sha1("\n".join(sorted(overrides)).encode("utf-8")).hexdigest()[:12]
+
+
+def _profile_text(profile) -> str:
+    return json.dumps({"solver": profile.solver, "time_limit_s": profile.time_limit_s, "threads": profile.threads,
+                       "options": profile.options}, sort_keys=True, default=str)
+
+
+def _flatten(table: dict, prefix: str = "") -> dict:
+    """``{"a": {"b": 1}}`` and ``{"a.b": 1}`` both give ``{"a.b": 1}`` (quoted or bare dotted keys)."""
+    out: dict = {}
+    for key, value in table.items():
+        name = f"{prefix}{key}"
+        if isinstance(value, dict):
+            out.update(_flatten(value, f"{name}."))
+        else:
+            out[name] = value
+    return out
+
+
+def _read(path: Path) -> dict:
+    if not path.is_file():
+        raise UamoptError(f"sweep file not found: {path}", str(path), "give the path of a sweep .toml, e.g. models/variants/speed.toml")
+    try:
+        return tomllib.loads(path.read_text(encoding="utf-8"))
+    except tomllib.TOMLDecodeError as exc:
+        raise ScenarioError(f"malformed TOML: {exc}", str(path), "fix the syntax at that line") from None
+    except UnicodeDecodeError:
+        raise ScenarioError("sweep file is not UTF-8 text", str(path), "save it as UTF-8 TOML") from None
+
+
+def _apply_small(raw: dict, where: str) -> dict:
+    small = raw.get("small", {})
+    if not isinstance(small, dict):
+        raise ScenarioError("[small] must be a table", where, f"use keys among {', '.join(sorted(SMALL_KEYS))}")
+    unknown = sorted(set(small) - SMALL_KEYS)
+    if unknown:
+        raise ScenarioError(f"unknown key 'small.{unknown[0]}'", where, f"[small] takes {', '.join(sorted(SMALL_KEYS))}")
+    out = dict(raw)
+    for key in ("solvers", "seeds", "time_limit_s"):
+        if key in small:
+            out[key] = small[key]
+    for key in ("set", "grid"):
+        if key in small:
+            out[key] = {**_flatten(raw.get(key, {})), **_flatten(small[key])}
+    return out
+
+
+def _seeds(raw: Any, where: str) -> tuple[int, ...]:
+    if not isinstance(raw, list) or not raw or not all(isinstance(s, int) and not isinstance(s, bool) for s in raw):
+        raise ScenarioError(f"seeds must be a non-empty list of integers, got {raw!r}", where, "write e.g. seeds = [0, 1, 2]")
+    if len(set(raw)) != len(raw):
+        raise ScenarioError(f"seeds repeat a value: {raw!r}", where, "list each seed once")
+    return tuple(raw)
+
+
+def _profiles(raw: Any, base_dir: Path, time_limit_s: float | None, where: str) -> tuple:
+    from uamopt.solvers import load_profile
+
+    if not isinstance(raw, list) or not raw or not all(isinstance(s, str) for s in raw):
+        raise ScenarioError(f"solvers must be a non-empty list of profile names, got {raw!r}", where,
+                            'write e.g. solvers = ["greedy", "highs"]')
+    profiles = []
+    for text in raw:
+        path = Path(text)
+        try:
+            profile = load_profile(base_dir / path if path.suffix and not path.is_absolute() else text)
+        except UamoptError as exc:
+            raise type(exc)(exc.what, f"{where} solvers", exc.fix) from None
+        if time_limit_s is not None:
+            profile = replace(profile, time_limit_s=time_limit_s)
+        profiles.append(profile)
+    names = [p.name for p in profiles]
+    if len(set(names)) != len(names):
+        raise ScenarioError(f"two solver profiles share a name: {names}", where, "list each profile once")
+    return tuple(profiles)
+
+
+def _scenario(base: Path, overrides: list[str], where: str, key: str | None = None):
+    from uamopt.scenario import load_scenario
+
+    try:
+        return load_scenario(base, overrides)
+    except ScenarioError as exc:
+        place = f"{where} [grid] \"{key}\"" if key else where
+        raise ScenarioError(exc.what, place, exc.fix) from None
+
+
+def load_sweep(path: str | Path, small: bool = False) -> SweepSpec:
+    """Parse and validate a sweep file; every case's scenario is built (and so checked) here.
+
+    Parameters
+    ----------
+    path : str or Path
+        The sweep TOML file.
+    small : bool
+        Apply the file's ``[small]`` table (the fast version the tests run).
+
+    Raises
+    ------
+    ScenarioError, UamoptError
+        Unknown key (in the file or a scenario key in ``[set]``/``[grid]``), empty grid, bad
+        stage, seeds or solvers, a case whose scenario is invalid.
+    """
+    path = Path(path)
+    where = str(path)
+    raw = _read(path)
+    unknown = sorted(set(raw) - FILE_KEYS)
+    if unknown:
+        raise ScenarioError(f"unknown key '{unknown[0]}'", where, f"a sweep file takes {', '.join(sorted(FILE_KEYS))}")
+    if small:
+        if "small" not in raw:
+            raise ScenarioError("the sweep file has no [small] table", where, "add [small] overrides or drop --small")
+        raw = _apply_small(raw, where)
+    if not isinstance(raw.get("base"), str):
+        raise ScenarioError("missing key 'base'", where, 'name the base scenario, e.g. base = "../paper_case.toml"')
+    base = (path.parent / raw["base"]).resolve()
+    stage = raw.get("stage", "schedule")
+    if stage not in STAGES:
+        raise ScenarioError(f"unknown stage {stage!r}", where, f"use one of {', '.join(STAGES)}")
+    time_limit = raw.get("time_limit_s")
+    if time_limit is not None and (isinstance(time_limit, bool) or not isinstance(time_limit, (int, float)) or not time_limit > 0):
+        raise ScenarioError(f"time_limit_s must be a positive number, got {time_limit!r}", where, "give seconds, e.g. 30.0")
+    if stage == "schedule":
+        solvers = _profiles(raw.get("solvers", ["greedy"]), path.parent, None if time_limit is None else float(time_limit), where)
+        seeds = _seeds(raw.get("seeds", [0]), where)
+    else:
+        for key in ("solvers", "seeds", "time_limit_s"):
+            if key in raw:
+                raise ScenarioError(f"'{key}' applies to stage = \"schedule\" only", where, "remove it or set stage = \"schedule\"")
+        solvers, seeds = (), ()
+    fixed = _flatten(raw.get("set", {}))
+    grid = _flatten(raw.get("grid", {}))
+    if not grid:
+        raise ScenarioError("empty grid: no [grid] lists", where, 'add a [grid] table, e.g. "schedule.flights" = [60, 120]')
+    for key, values in grid.items():
+        if not isinstance(values, list) or not values:
+            raise ScenarioError(f"empty grid: [grid] \"{key}\" has no values", where, f"give \"{key}\" a non-empty list of values")
+        if len({toml_value(v) for v in values}) != len(values):
+            raise ScenarioError(f"[grid] \"{key}\" repeats a value", where, "list each value once")
+        if key in fixed:
+            raise ScenarioError(f"'{key}' is both in [set] and in [grid]", where, "keep it in one of them")
+    figure = raw.get("figure")
+    if figure is not None:
+        from uamopt.experiments.figures import KEYS
+
+        if figure not in KEYS:
+            raise ScenarioError(f"unknown figure {figure!r}", where, f"use one of {', '.join(KEYS)}, or remove it")
+        if KEYS[figure] not in grid:
+            raise ScenarioError(f"figure {figure!r} needs \"{KEYS[figure]}\" in [grid]", where, "sweep that key or remove it")
+    fixed_overrides = [f"{k}={toml_value(v)}" for k, v in fixed.items()]
+    for key, value in fixed.items():  # name the faulty key before trying combinations
+        _scenario(base, [f"{key}={toml_value(value)}"], f"{where} [set] \"{key}\"")
+    for key, values in grid.items():
+        _scenario(base, fixed_overrides + [f"{key}={toml_value(values[0])}"], where, key)
+    cases = []
+    for index, combo in enumerate(itertools.product(*grid.values())):
+        values = dict(zip(grid, combo))
+        overrides = tuple(fixed_overrides + [f"{k}={toml_value(v)}" for k, v in values.items()])
+        shown = ", ".join(f"{k} = {toml_value(v)}" for k, v in values.items())
+        cases.append(Case(index, case_id(overrides), values, overrides, _scenario(base, list(overrides), f"{where} case {shown}")))
+    return SweepSpec(path=path, name=str(raw.get("name", path.stem)), base=base, stage=stage, solvers=solvers, seeds=seeds,
+                     fixed=fixed, grid=grid, cases=tuple(cases), time_limit_s=time_limit, figure=figure, small=small)

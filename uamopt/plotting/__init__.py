@@ -1,0 +1,49 @@
+"""Figures of every stage: each plot function draws, returns the matplotlib Figure and writes
+nothing; :func:`save` writes a figure to a file.
+
+    import uamopt.plotting as plotting
+    fig = plotting.risk(field, vertiports=scenario.network.vertiports)   # a Figure: Jupyter shows it
+    plotting.save(fig, "risk.png")
+    plotting.tracks(plan, model, ax=my_axes)                             # draw map (a) into your axes
+
+Every function takes ``ax=``: None (a new figure in the page layout the CLI writes), a Figure
+or SubFigure (the page laid out in it), one Axes (the first panel only), or, for the multi-panel
+pages, a sequence of Axes with one per panel. See each function for its panels.
+
+============================  ==================================================  =========
+function                      draws                                               panels
+============================  ==================================================  =========
+:func:`risk`                  risk map, city, section, profiles (Eqs. 8–9, 14)    5
+:func:`risk_components`       each term of Eq. 8 by altitude                      4
+:func:`tracks`                the four stages of Fig. 18 / Table 2               3
+:func:`network`               every route and direction, their profiles           2
+:func:`pareto`                the risk–transport front of Fig. 21                 1
+:func:`gantt`                 one schedule per aircraft (Eqs. 24–28)              1
+:func:`delays`                delay per flight and solver (Fig. 19)               1
+============================  ==================================================  =========
+
+Importing this package in Jupyter lets a returned Figure display as a PNG without pyplot
+(:func:`uamopt.plotting.style.show_figures_in`). This package imports matplotlib; ``import uamopt`` does not import it. The submodules ``risk``,
+``tracks``, ``network`` and ``schedule`` are shadowed here by the functions of the same name
+(import from them with ``from uamopt.plotting.tracks import STAGE_STYLE``); shared
+helpers are public in :mod:`uamopt.plotting.style` and :mod:`uamopt.plotting.geometry`.
+"""
+
+from uamopt.plotting.network import network
+from uamopt.plotting.risk import risk, risk_components
+from uamopt.plotting.schedule import delays, gantt
+from uamopt.plotting.style import DPI, save, show_figures_in
+from uamopt.plotting.tracks import pareto, tracks
+
+
+def _running_shell():
+    """The IPython shell this code runs in, if any (IPython is not imported for it)."""
+    import sys
+
+    ipython = sys.modules.get("IPython")
+    return ipython.get_ipython() if ipython is not None else None
+
+
+show_figures_in(_running_shell())
+
+__all__ = ["DPI", "delays", "gantt", "network", "pareto", "risk", "risk_components", "save", "tracks"]

@@ -1,0 +1,160 @@
+"""What each command does, as library functions: run the stages (``uamopt.pipeline``) and write a
+complete output folder (staged, moved into place only when complete; docs/interfaces.md).
+
+Each ``*_folder`` function returns the in-memory result, so a notebook can write the same folder a
+command writes. ``figures=False`` skips the PNGs (``--no-figures``).
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from pathlib import Path
+
+from uamopt.scenario import Scenario
+
+
+def progress(total: int, desc: str):
+    """A progress bar on a terminal, silent otherwise."""
+    from tqdm import tqdm
+
+    return tqdm(total=total, desc=desc, disable=not sys.stderr.isatty(), leave=False)
+
+
+def write_risk(field, scenario: Scenario, folder: Path, figures: bool = True) -> dict:
+    """risk.npz, summary.json (and risk.png) of a computed field into ``folder``; the summary."""
+    from uamopt.io import save_risk
+
+    save_risk(field, folder)
+    if figures:
+        from uamopt import plotting
+
+        plotting.save(plotting.risk(field, vertiports=scenario.network.vertiports,
+                                    cruise_altitude_m=scenario.network.cruise_altitude_m, title=scenario.name),
+                      folder / "risk.png")
+    return field.summary()
+
+
+def write_network(network, model, scenario: Scenario, folder: Path, figures: bool = True) -> None:
+    """network.json (and network.png) into ``folder``."""
+    from uamopt.io import save_network
+
+    save_network(network, folder)
+    if figures:
+        from uamopt import plotting
+
+        plotting.save(plotting.network(model, network.waypoints(), vertiports=scenario.network.vertiports),
+                      folder / "network.png")
+
+
+def risk_folder(scenario: Scenario, out: str | Path, figures: bool = True):
+    """``uamopt risk``: the risk field and its folder."""
+    from uamopt.outputs import check_out_dir, staged_output
+    from uamopt.pipeline import compute_risk
+
+    check_out_dir(out)
+    with progress(2, "risk") as bar, staged_output(out) as stage:
+        field = compute_risk(scenario)
+        bar.update(1)
+        write_risk(field, scenario, stage, figures)
+        bar.update(1)
+    return field
+
+
+def plan_folder(scenario: Scenario, out: str | Path, origin=None, destination=None, figures: bool = True):
+    """``uamopt plan``: the four stages between two end points (default: the scenario's route)."""
+    from uamopt.io import save_tracks
+    from uamopt.outputs import check_out_dir, staged_output
+    from uamopt.pipeline import compute_risk, plan_track, planning_model
+
+    check_out_dir(out)
+    with progress(3, "plan") as bar, staged_output(out) as stage:
+        model = planning_model(scenario, compute_risk(scenario))
+        bar.update(1)
+        plan = plan_track(model, origin, destination)
+        bar.update(1)
+        save_tracks(plan, stage, scenario)
+        if figures:
+            from uamopt import plotting
+
+            plotting.save(plotting.tracks(plan, model, title=scenario.name), stage / "tracks.png")
+        bar.update(1)
+    return plan
+
+
+def network_folder(scenario: Scenario, out: str | Path, figures: bool = True):
+    """``uamopt network``: one planned track per route and direction."""
+    from uamopt.outputs import check_out_dir, staged_output
+    from uamopt.pipeline import compute_risk, plan_network, planning_model
+
+    check_out_dir(out)
+    with progress(2 + 2 * len(scenario.network.route_list()), "network") as bar, staged_output(out) as stage:
+        model = planning_model(scenario, compute_risk(scenario))
+        bar.update(2)
+        network = plan_network(model, progress=bar)
+        write_network(network, model, scenario, stage, figures)
+    return network
+
+
+def scenario_flights(scenario: Scenario, flights_file=None, network_file=None, seed: int | None = None):
+    """The flights to schedule: ``flights_file`` (self-contained, or on ``network_file``'s routes),
+    else the generated plan on ``network_file`` or on the network planned now."""
+    from uamopt.grid import build_grid
+    from uamopt.io import load_flights, load_network
+    from uamopt.pipeline import compute_risk, generate_flights, plan_network, planning_model
+
+    network = load_network(network_file) if network_file else None
+    if flights_file:
+        return load_flights(flights_file, scenario, build_grid(scenario), network and network.waypoints())
+    if network is None:
+        network = plan_network(planning_model(scenario, compute_risk(scenario)))
+    return generate_flights(scenario, network, seed)
+
+
+def flights_folder(scenario: Scenario, out: str | Path, seed: int | None = None):
+    """``uamopt flights``: the generated plan as a self-contained flights.json (instance generator)."""
+    from uamopt.outputs import check_out_dir, staged_output, write_json
+    from uamopt.pipeline import build_problem
+    from uamopt.schedule import save_flights
+
+    check_out_dir(out)
+    with progress(2, "flights") as bar, staged_output(out) as stage:
+        flights = scenario_flights(scenario, seed=seed)
+        bar.update(1)
+        problem = build_problem(flights, scenario)
+        save_flights(stage / "flights.json", flights)
+        write_json(stage / "summary.json", {
+            "scenario": scenario.name, "flights": len(flights), "aircraft": flights.n_aircraft,
+            "vertiports": len(scenario.network.vertiports), "directed_routes": 2 * len(scenario.network.route_list()),
+            "tracks": scenario.network.tracks, "conflicting_pairs": len(problem.conflicts),
+            "seed": scenario.schedule.plan_seed if seed is None else seed, "plan_notes": list(flights.notes)})
+        bar.update(1)
+    return problem
+
+
+def schedule_folder(scenario: Scenario, out: str | Path, profile, flights_file=None, network_file=None,
+                    seed: int | None = None, overrides: list[str] | None = None):
+    """``uamopt schedule``: solve and write flights.json, schedule.csv, summary.json; returns
+    (problem, schedule, violations found by the independent verifier in the written folder)."""
+    from uamopt.export.frame import schedule_provenance
+    from uamopt.outputs import check_out_dir
+    from uamopt.pipeline import build_problem, solve
+    from uamopt.schedule import write_schedule
+    from uamopt.schedule.verify import verify_dir
+    from uamopt.solvers import load_profile
+
+    profile = load_profile(profile) if isinstance(profile, (str, Path)) else profile
+    check_out_dir(out)
+    with progress(3, "schedule") as bar:
+        flights = scenario_flights(scenario, flights_file, network_file, seed)
+        bar.update(1)
+        problem = build_problem(flights, scenario)
+        bar.update(1)
+        schedule = solve(problem, profile)
+        bar.update(1)
+    write_schedule(out, problem, schedule, extra=schedule_provenance(scenario, list(overrides or [])))
+    return problem, schedule, verify_dir(out)
+
+
+def elapsed_since(started: float) -> float:
+    return time.perf_counter() - started
