@@ -5,22 +5,24 @@ and turns instantly at every waypoint. No aircraft can: at bank φ it turns on a
 v²/(g tan φ) (64 m at 25 m/s and 45°), so BlueSky, handed the waypoints, cuts every corner
 tighter than that and, flying the shorter path at v_g, gets ahead of the plan for the rest of the
 flight (docs/export.md). The export therefore designs, once per track, the trajectory a(t)
-sampled every h seconds that stays nearest to the plan p(t) *at the same time* while never asking
-for more acceleration than the aircraft can pull:
+at nodes t_0 = 0 < t_1 < … < t_n = T that stays nearest to the plan p(t) *at the same time* while
+never asking for more acceleration than the aircraft can pull:
 
     minimise   e + (λ/(n+1)) Σ_k |a_k − p(t_k)|²
-    subject to |a_k − p(t_k)| ≤ e                          every node t_k = k·h, k = 0 … n
+    subject to |a_k − p(t_k)| ≤ e                          every node t_k
                |a(τ_j) − p(τ_j)| ≤ e                       every waypoint time τ_j of the plan
-               |a_{k+1} − 2a_k + a_{k−1}| ≤ η·g·tan φ·h²   every interior node
+               |v_k − v_{k−1}| ≤ η·g·tan φ·(h_{k−1} + h_k)/2   every interior node, with
+                         h_k = t_{k+1} − t_k and v_k = (a_{k+1} − a_k)/h_k
                a_0 = p(0),  a_1 − a_0 = p(t_1) − p(0),  a_n = p(T)
 
-in the horizontal plane (a second-order cone program, solved exactly by Clarabel through cvxpy);
-z is the plan's at every node, which BlueSky's VNAV flies leg by leg. Between breakpoints both
-a(t) and p(t) are linear in t, so |a − p| is convex there and its largest value lies at a node or
-at a waypoint time: ``max_error_m`` = e is the exact largest distance between the designed
-polyline and the plan at equal times. The second difference is the velocity change over one node,
-so the acceleration (lateral and along-track together) stays ≤ η·g·tan φ; η = 0.9 leaves a tenth
-of the bank's lateral acceleration to BlueSky's own fly-by guidance between the nodes. The
+in the horizontal plane (a second-order cone program, solved exactly by Clarabel through cvxpy).
+The nodes lie every h seconds, plus the plan's changes of climb gradient; z is the plan's at
+every node, so the designed z profile is the plan's and BlueSky's VNAV flies it leg by leg.
+Between breakpoints both a(t) and p(t) are linear in t, so |a − p| is convex there and its
+largest value lies at a node or at a waypoint time: ``max_error_m`` = e is the exact largest
+distance between the designed polyline and the plan at equal times. The velocity change per
+node bounds the acceleration (lateral and along-track together) by η·g·tan φ; η = 0.9 leaves a
+tenth of the bank's lateral acceleration to BlueSky's own fly-by guidance between the nodes. The
 trajectory leaves on the plan at the plan's velocity and arrives at the destination at the
 planned time; on the way it may speed up or slow down (``speed_range_mps``) to stay on time.
 """
@@ -37,7 +39,8 @@ G_MPS2 = 9.80665
 DESIGN_STEP_S = 0.25  # h: node spacing, s (6.25 m at 25 m/s; BlueSky follows 0.5 s nodes ~1 m less closely)
 ACCEL_SHARE = 0.9  # η: share of the bank's lateral acceleration the design may use
 SMOOTHING_WEIGHT = 1e-3  # λ, 1/m: among minimax trajectories, the one nearest to the plan on average
-STRAIGHT_TOL_M = 1e-3  # a node whose velocity does not change (|Δ²a| below this) is dropped
+STRAIGHT_TOL_MPS = 4e-4  # a node where the velocity changes by less than this, m/s, is dropped
+GRADE_CHANGE = 1e-3  # a plan corner where dz/ds changes by more than this is also a node
 
 
 @dataclass(frozen=True)
@@ -79,6 +82,22 @@ def _plan_at(plan: Trajectory, t: np.ndarray) -> np.ndarray:
     return np.column_stack([np.interp(t, plan.times_s, plan.points[:, k]) for k in range(3)])
 
 
+def _nodes(plan: Trajectory, step_s: float) -> np.ndarray:
+    """Node times: every ``step_s`` from 0 to T, and the plan's changes of climb gradient (so that
+    z, the plan's at every node, breaks exactly where the plan's does); a regular node closer
+    than half a step to one of those gives way to it."""
+    total = float(plan.times_s[-1])
+    regular = np.linspace(0.0, total, max(2, int(np.ceil(total / step_s - 1e-9))) + 1)
+    legs = np.diff(plan.points, axis=0)
+    grade = legs[:, 2] / np.maximum(np.linalg.norm(legs[:, :2], axis=1), 1e-9)
+    slope = plan.times_s[1:-1][np.abs(np.diff(grade)) > GRADE_CHANGE]
+    if not len(slope):
+        return regular
+    near = np.abs(regular[:, None] - slope[None, :]).min(axis=1) < 0.5 * step_s
+    near[[0, -1]] = False
+    return np.union1d(regular[~near], slope)
+
+
 def flyable_trajectory(waypoints: np.ndarray, speed_mps: float, bank_deg: float, *,
                        step_s: float = DESIGN_STEP_S, accel_share: float = ACCEL_SHARE) -> Trajectory:
     """The trajectory nearest to the plan within the acceleration η·g·tan φ (module docstring).
@@ -97,8 +116,9 @@ def flyable_trajectory(waypoints: np.ndarray, speed_mps: float, bank_deg: float,
     Returns
     -------
     Trajectory
-        Nodes every h seconds from the departure (nodes on straight runs flown at constant
-        velocity dropped) and e, the exact largest distance to the plan at equal times.
+        Nodes every h seconds from the departure and at the plan's changes of gradient (nodes
+        on straight runs flown at constant velocity dropped) and e, the exact largest distance
+        to the plan at equal times.
 
     Raises
     ------
@@ -115,23 +135,22 @@ def flyable_trajectory(waypoints: np.ndarray, speed_mps: float, bank_deg: float,
     import scipy.sparse as sp
 
     plan = plan_trajectory(waypoints, speed_mps)
-    total = float(plan.times_s[-1])
-    n = max(2, int(np.ceil(total / step_s - 1e-9)))
-    h = total / n
-    t = np.linspace(0.0, total, n + 1)
+    t = _nodes(plan, step_s)
+    n, span = len(t) - 1, np.diff(t)
     target = _plan_at(plan, t)
     p = target[:, :2]
     tau = plan.times_s[1:-1]  # the plan's corners: breakpoints of p(t)
-    k = np.minimum((tau / h).astype(int), n - 1)
-    w = tau / h - k
+    k = np.clip(np.searchsorted(t, tau, side="right") - 1, 0, n - 1)
+    w = (tau - t[k]) / span[k]
     rows = np.arange(len(tau))
     at_tau = sp.csr_matrix((np.concatenate([1 - w, w]), (np.concatenate([rows, rows]), np.concatenate([k, k + 1]))),
                            shape=(len(tau), n + 1))
-    second = sp.diags([np.ones(n - 1), -2 * np.ones(n - 1), np.ones(n - 1)], [0, 1, 2], shape=(n - 1, n + 1))
+    velocity = sp.diags(1.0 / span) @ sp.diags([-np.ones(n), np.ones(n)], [0, 1], shape=(n, n + 1))
+    change = sp.diags([-np.ones(n - 1), np.ones(n - 1)], [0, 1], shape=(n - 1, n)) @ velocity
     a, e = cp.Variable((n + 1, 2)), cp.Variable()
     accel = accel_share * G_MPS2 * np.tan(np.radians(bank_deg))
     constraints = [a[0] == p[0], a[1] - a[0] == p[1] - p[0], a[n] == p[n],
-                   cp.norm(a - p, axis=1) <= e, cp.norm(second @ a, axis=1) <= accel * h * h]
+                   cp.norm(a - p, axis=1) <= e, cp.norm(change @ a, axis=1) <= accel * 0.5 * (span[:-1] + span[1:])]
     if len(tau):
         constraints.append(cp.norm(at_tau @ a - plan.points[1:-1, :2], axis=1) <= e)
     problem = cp.Problem(cp.Minimize(e + SMOOTHING_WEIGHT / (n + 1) * cp.sum_squares(a - p)), constraints)
@@ -141,8 +160,8 @@ def flyable_trajectory(waypoints: np.ndarray, speed_mps: float, bank_deg: float,
                           "replay the track's own waypoints: --trajectory waypoints")
     points = np.column_stack([a.value, target[:, 2]])
     points[[0, -1]] = target[[0, -1]]
-    bend = np.linalg.norm(points[2:] - 2 * points[1:-1] + points[:-2], axis=1)
-    keep = np.concatenate([[True], bend > STRAIGHT_TOL_M, [True]])
+    bend = np.linalg.norm(np.diff(np.diff(points, axis=0) / span[:, None], axis=0), axis=1)
+    keep = np.concatenate([[True], bend > STRAIGHT_TOL_MPS, [True]])
     # the exact largest distance of the kept polyline (nodes and plan corners), not the solver's e
     flown = Trajectory(t[keep], points[keep], 0.0)
     when = np.concatenate([t, plan.times_s])

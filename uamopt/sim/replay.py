@@ -187,7 +187,8 @@ def replay(path: str | Path, *, dt_s: float = DEFAULT_DT_S, bank_deg: float = DE
                 "trajectory": trajectory,
                 "cd_method": meta["cd_method"], "bluesky_zone_m": meta["zone_m"], "window_s": window_s,
                 "frame": folder.frame.as_dict(), "frame_recorded": folder.frame_recorded}
-    seconds = {"simulated": meta["end_s"], "simulation": meta["wall_s"], "total": time.perf_counter() - started}
+    seconds = {"simulated": meta["end_s"], "simulation": meta["wall_s"], "simulation_cpu": meta["cpu_s"],
+               "bluesky_cpu": meta["process_cpu_s"], "total": time.perf_counter() - started}
     result = ReplayResult(folder.path, zone, result[0], result[1], result[2], settings, seconds)
     if write:
         from uamopt.sim.plot import plot_replay
