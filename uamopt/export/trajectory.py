@@ -13,7 +13,7 @@ never asking for more acceleration than the aircraft can pull:
                |a(τ_j) − p(τ_j)| ≤ e                       every waypoint time τ_j of the plan
                |v_k − v_{k−1}| ≤ η·g·tan φ·(h_{k−1} + h_k)/2   every interior node, with
                          h_k = t_{k+1} − t_k and v_k = (a_{k+1} − a_k)/h_k
-               a_0 = p(0),  a_1 − a_0 = p(t_1) − p(0),  a_n = p(T)
+               a_0 = p(0),  a_n = p(T)
 
 in the horizontal plane (a second-order cone program, solved exactly by Clarabel through cvxpy).
 The nodes lie every h seconds, plus the plan's changes of climb gradient; z is the plan's at
@@ -23,8 +23,11 @@ largest value lies at a node or at a waypoint time: ``max_error_m`` = e is the e
 distance between the designed polyline and the plan at equal times. The velocity change per
 node bounds the acceleration (lateral and along-track together) by η·g·tan φ; η = 0.9 leaves a
 tenth of the bank's lateral acceleration to BlueSky's own fly-by guidance between the nodes. The
-trajectory leaves on the plan at the plan's velocity and arrives at the destination at the
-planned time; on the way it may speed up or slow down (``speed_range_mps``) to stay on time.
+trajectory leaves from the plan's first point at the departure (BlueSky creates the aircraft
+there already moving, along the first designed leg: the plan's own velocity at that instant is no
+constraint, so a corner soon after the departure can be prepared from the start) and arrives at
+the destination at the planned time; on the way it may speed up or slow down
+(``speed_range_mps``) to stay on time.
 """
 
 from __future__ import annotations
@@ -149,7 +152,7 @@ def flyable_trajectory(waypoints: np.ndarray, speed_mps: float, bank_deg: float,
     change = sp.diags([-np.ones(n - 1), np.ones(n - 1)], [0, 1], shape=(n - 1, n)) @ velocity
     a, e = cp.Variable((n + 1, 2)), cp.Variable()
     accel = accel_share * G_MPS2 * np.tan(np.radians(bank_deg))
-    constraints = [a[0] == p[0], a[1] - a[0] == p[1] - p[0], a[n] == p[n],
+    constraints = [a[0] == p[0], a[n] == p[n],
                    cp.norm(a - p, axis=1) <= e, cp.norm(change @ a, axis=1) <= accel * 0.5 * (span[:-1] + span[1:])]
     if len(tau):
         constraints.append(cp.norm(at_tau @ a - plan.points[1:-1, :2], axis=1) <= e)
