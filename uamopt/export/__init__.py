@@ -2,6 +2,7 @@
 
     export_bluesky("out/sched")   # out/sched/bluesky.scn: a BlueSky scenario of the operated flights
     export_geojson("out/sched")   # tracks.geojson, vertiports.geojson, unsafe.geojson in WGS 84
+    flyable_trajectory(waypoints, 25.0, 45.0)   # what the BlueSky export commands for one track
 
 The georeference of the local frame is :mod:`uamopt.export.frame`; the replay in BlueSky is
 :func:`uamopt.sim.replay`.
@@ -10,5 +11,6 @@ The georeference of the local frame is :mod:`uamopt.export.frame`; the replay in
 from uamopt.export.bluesky import export_bluesky
 from uamopt.export.frame import LocalFrame, scenario_frame
 from uamopt.export.geojson import export_geojson
+from uamopt.export.trajectory import Trajectory, flyable_trajectory
 
-__all__ = ["LocalFrame", "export_bluesky", "export_geojson", "scenario_frame"]
+__all__ = ["LocalFrame", "Trajectory", "export_bluesky", "export_geojson", "flyable_trajectory", "scenario_frame"]

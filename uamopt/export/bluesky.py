@@ -7,7 +7,7 @@ its trajectory and deleted when it passes the last point. Writing needs no BlueS
 
 The trajectory (``trajectory``): by default the flyable trajectory nearest to the plan
 (:mod:`uamopt.export.trajectory`: the plan turns instantly, an aircraft cannot; the design keeps
-to the plan's position *and time* within the acceleration of the bank limit, e.g. ≤ 8.0 m on
+to the plan's position *and time* within the acceleration of the bank limit, e.g. ≤ 7.81 m on
 the paper case's tracks); ``"waypoints"`` hands BlueSky the track's own waypoints at v_g, whose
 corners BlueSky cuts with its fly-by turns while flying on at v_g, ahead of the plan after each.
 
