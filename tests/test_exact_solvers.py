@@ -11,8 +11,6 @@ bounds meet and CP-SAT is exact.
 
 from __future__ import annotations
 
-import subprocess
-import sys
 import time
 from dataclasses import replace
 
@@ -219,24 +217,7 @@ def test_bruteforce_refuses_large_instances(paper_problem):
         bruteforce.solve(paper_problem)
 
 
-def test_both_solvers_in_one_process_either_order(root):
-    """highspy 1.15.1 and ortools 9.15 ship clashing libhighs.so.1 builds: whichever solver comes
-    second runs in a worker process. Here cpsat first (in a fresh interpreter), then highs."""
-    script = (
-        "from uamopt.scenario import load_scenario\n"
-        "from uamopt.grid import AirspaceGrid\n"
-        "from uamopt.schedule import build_problem, generate_plan, straight_network\n"
-        "from uamopt.solvers import solve\n"
-        f"sc = load_scenario({str(PAPER_CASE)!r})\n"
-        "grid = AirspaceGrid.from_extent(sc.grid.cell, sc.grid.extent)\n"
-        "pb = build_problem(generate_plan(sc, straight_network(sc, grid), seed=0, aircraft=4), sc)\n"
-        "a, b = solve(pb, 'cpsat'), solve(pb, 'highs')\n"
-        "print(a.status, b.status, a.objective - b.objective)\n"
-    )
-    out = subprocess.run([sys.executable, "-c", script], check=False, capture_output=True, text=True, cwd=root, timeout=120)
-    assert out.returncode == 0, out.stderr
-    status_a, status_b, difference = out.stdout.split()
-    assert status_a == status_b == "optimal" and -OBJ_TOL <= float(difference) <= 0.1  # CP-SAT: u-rounded
+# (both solvers in one process, either order: tests/test_timeindexed.py)
 
 
 # --- (c) time limit ---------------------------------------------------------------------------

@@ -209,10 +209,12 @@ class Schedule:
         return self.total_delay_s / self.aircraft_count
 
     def summary(self) -> dict:
-        """The keys of summary.json (INTERFACES.md)."""
+        """The keys of summary.json (INTERFACES.md), plus ``model`` (what the status and bound are
+        about, e.g. a delay grid) and ``continuous_bound`` when the solver gives them."""
+        named = {key: self.extras[key] for key in ("model", "continuous_bound", "continuous_bound_model") if key in self.extras}
         return {
             "solver": self.solver, "status": self.status, "objective": self.objective, "bound": self.bound,
-            "gap": self.gap, "operated": self.operated_count, "cancelled": self.cancelled,
+            "gap": self.gap, **named, "operated": self.operated_count, "cancelled": self.cancelled,
             "total_delay_s": self.total_delay_s, "avg_delay_s": self.avg_delay_s,
             "solve_seconds": self.solve_seconds, "seed": self.seed,
         }

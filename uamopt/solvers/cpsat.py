@@ -31,12 +31,11 @@ CP-SAT's bound mapped back, a bound of the *discretised* model (``extras["bound_
 Profile options: ``time_unit_s`` (default 0.01); ``threads`` → ``num_workers``, ``seed`` →
 ``random_seed``, ``time_limit_s`` → ``max_time_in_seconds``; other options are CP-SAT parameters
 (a list extends a repeated one). Defaults: ``linearization_level = 2`` with one thread,
-``subsolvers = ["max_lp", "default_lp"]`` with more (see ``solve_here``).
+``subsolvers = ["max_lp", "default_lp"]`` with more (see ``solve``).
 """
 
 from __future__ import annotations
 
-import functools
 import math
 from fractions import Fraction
 
@@ -44,7 +43,6 @@ import numpy as np
 
 from uamopt.errors import UamoptError
 from uamopt.schedule.model import Schedule, SchedulingProblem, make_schedule
-from uamopt.solvers.milp import native_loaded, serve, solve_isolated
 
 ROUND_S = 1e-9  # float round-off accepted when rounding a real time to units, s
 INT_LIMIT = 2**62  # keep |objective| below this (CP-SAT uses int64)
@@ -114,40 +112,24 @@ def _bound(problem: SchedulingProblem, raw: float, per_flight: int, divisor: flo
 
 
 def solve(problem: SchedulingProblem, profile) -> Schedule:
-    """Solve the discretised model with CP-SAT; status optimal | feasible | time_limit | infeasible.
-
-    OR-Tools bundles its own libhighs.so.1, which may clash with highspy's: when OR-Tools fails
-    to import because highspy is loaded here, CP-SAT runs in a worker process
-    (``milp.solve_isolated``).
-    """
-    if not _importable_here():
-        if native_loaded("highspy"):
-            return solve_isolated(__name__, problem, profile)
-        raise UamoptError("OR-Tools is not installed", f"profile {profile.name or 'cpsat'}", "pip install ortools")
-    return solve_here(problem, profile)
-
-
-@functools.cache
-def _importable_here() -> bool:
-    """Whether OR-Tools imports in this process; asked once (a failed try costs ~0.1 s, and a
-    loaded highspy stays loaded)."""
-    try:
-        from ortools.sat.python import cp_model  # noqa: F401
-    except ImportError:
-        return False
-    return True
-
-
-def solve_here(problem: SchedulingProblem, profile) -> Schedule:
-    """:func:`solve` in this process."""
+    """Solve the discretised model with CP-SAT; status optimal | time_limit | infeasible, from CP-SAT's
+    own termination (OPTIMAL: proved on the u-lattice model; FEASIBLE: stopped by the time limit,
+    the only limit set). Hinted with the best cheap heuristic schedule on the ΔT_a grid
+    (:mod:`~uamopt.solvers.warmstart`), and never worse than it."""
     from ortools.sat.python import cp_model
+
+    from uamopt.solvers.warmstart import no_worse, reduced, warm_start
 
     options = dict(profile.options)
     unit_s = float(options.pop("time_unit_s", 0.01))
     if not (math.isfinite(unit_s) and unit_s > 0):
         raise UamoptError(f"time_unit_s must be a positive number of seconds, got {unit_s}",
                           f"profile {profile.name or 'cpsat'}", "use e.g. 0.01")
-    model, operate, delay, _, per_flight, divisor, how = build_cpsat(problem, unit_s)
+    model, operate, delay, _, per_flight, divisor, how = build_cpsat(reduced(problem), unit_s)  # dominance caps (warmstart.py)
+    start = warm_start(problem, seed=profile.seed, on_grid=True)
+    for f in range(problem.n_flights):
+        model.add_hint(operate[f], bool(start.operated[f]))
+        model.add_hint(delay[f], int(np.rint(start.delay_s[f] / unit_s)) if start.operated[f] else 0)
     solver = cp_model.CpSolver()
     solver.parameters.max_time_in_seconds = float(profile.time_limit_s)
     solver.parameters.num_workers = int(profile.threads)
@@ -171,27 +153,21 @@ def solve_here(problem: SchedulingProblem, profile) -> Schedule:
     seconds = float(solver.wall_time)
     n = problem.n_flights
     extras = {"termination": solver.status_name(code), "time_unit_s": unit_s, "objective_scale": how,
-              "bound_of": "time-discretised model", "branches": int(solver.num_branches)}
+              "model": f"delay lattice {unit_s:g} s, constraints rounded outward (a restriction of the continuous "
+                       "model: its optimum is within the proved tolerance above the continuous one, see the docstring)",
+              "branches": int(solver.num_branches), "warm_start": f"{start.source} {start.objective:.6f}"}
     if code == cp_model.MODEL_INVALID:
         raise UamoptError(f"CP-SAT rejected the model: {model.validate()}", f"profile {profile.name or 'cpsat'}",
                           "report this as a bug")
     if code == cp_model.INFEASIBLE:
         return make_schedule(problem, "cpsat", "infeasible", np.zeros(n, bool), np.zeros(n), solve_seconds=seconds,
                              seed=profile.seed, extras=extras)
-    if code == cp_model.UNKNOWN:  # no incumbent before the limit: cancelling every flight is always feasible
-        extras["incumbent"] = "none found: every flight cancelled"
-        return make_schedule(problem, "cpsat", "time_limit", np.zeros(n, bool), np.zeros(n), solve_seconds=seconds,
-                             seed=profile.seed, extras=extras)
+    if code == cp_model.UNKNOWN:  # no incumbent before the limit: the warm start
+        return no_worse(problem, make_schedule(problem, "cpsat", "time_limit", np.zeros(n, bool), np.zeros(n),
+                                               solve_seconds=seconds, seed=profile.seed, extras=extras), start)
     operated = np.array([solver.boolean_value(v) for v in operate])
     delay_s = np.array([solver.value(v) for v in delay], dtype=float) * unit_s
-    if code == cp_model.OPTIMAL:
-        status = "optimal"
-    else:
-        status = "time_limit" if seconds >= 0.99 * profile.time_limit_s else "feasible"
+    status = "optimal" if code == cp_model.OPTIMAL else "time_limit"  # FEASIBLE: stopped by the time limit
     bound = _bound(problem, solver.best_objective_bound, per_flight, divisor, unit_s, how)
-    return make_schedule(problem, "cpsat", status, operated, delay_s, bound=bound, solve_seconds=seconds,
-                         seed=profile.seed, extras=extras)
-
-
-if __name__ == "__main__":
-    serve(solve_here)
+    return no_worse(problem, make_schedule(problem, "cpsat", status, operated, delay_s, bound=bound, solve_seconds=seconds,
+                                           seed=profile.seed, extras=extras), start)
