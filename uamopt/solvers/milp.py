@@ -212,15 +212,16 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
     Status: ``optimal`` (proved, within ``mip_rel_gap``), ``time_limit`` (limit hit; the incumbent
     with HiGHS's bound), ``infeasible``. HiGHS starts from the best cheap heuristic schedule
     (:func:`~uamopt.solvers.warmstart.warm_start`, a MIP start through ``Highs.setSolution``) and
-    never returns a worse one (:func:`~uamopt.solvers.warmstart.no_worse`).
+    never returns a worse one (:func:`~uamopt.solvers.warmstart.no_worse`). The model is built on
+    :func:`~uamopt.solvers.warmstart.reduced` (dominated delays cut off; the optima are unchanged).
     """
-    from uamopt.solvers.warmstart import no_worse, warm_start
+    from uamopt.solvers.warmstart import no_worse, reduced, warm_start
 
     options = dict(profile.options)
     options.setdefault("mip_rel_gap", 0.0)
     options.setdefault("random_seed", int(profile.seed))
     start = warm_start(problem, seed=profile.seed)
-    m = build_model(problem)  # not reduced(problem): HiGHS 1.14's presolve mis-solves some capped tiny models
+    m = build_model(reduced(problem))  # delay bounds capped by dominance: the same optima (warmstart.py)
     solver = SolverFactory(SOLVER_NAME)
     if solver is None or not solver.available():
         raise UamoptError("HiGHS is not available to Pyomo", f"solver {profile.name or 'highs'}", "pip install highspy")
@@ -229,7 +230,7 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
     result = solver.solve(m, time_limit=float(profile.time_limit_s), threads=int(profile.threads), solver_options=options,
                           load_solutions=False, raise_exception_on_nonoptimal_result=False)
     if _stale_solution(m, result):  # highspy 1.16: the start's values beside a better objective; solve cold
-        m = build_model(problem)
+        m = build_model(reduced(problem))
         result = SolverFactory(SOLVER_NAME).solve(m, time_limit=float(profile.time_limit_s), threads=int(profile.threads),
                                                   solver_options=options, load_solutions=False,
                                                   raise_exception_on_nonoptimal_result=False)
