@@ -95,6 +95,10 @@ def test_paper_case_highs_and_cpsat(paper_problem, tmp_path):
           f"observed {discrete.objective - exact.objective:.6f}")
     assert exact.objective - OBJ_TOL <= discrete.objective <= upper + OBJ_TOL
     assert discrete.operated_count == exact.operated_count
+    # CP-SAT's own continuous bound (the cell relaxation at u): OPT ∈ [bound, CP-SAT's objective]
+    assert discrete.extras["continuous_bound"] <= exact.objective + OBJ_TOL
+    print(f"CP-SAT optimal within {discrete.summary()['optimal_within']:.6f} of the continuous optimum (proved)")
+    assert discrete.objective - exact.objective - OBJ_TOL <= discrete.summary()["optimal_within"] < 0.05 * abs(exact.objective)
 
 
 def test_milp_model_is_inspectable(paper_problem):
@@ -197,6 +201,9 @@ def check_against_bruteforce(lattice: bool, problem: SchedulingProblem) -> None:
     assert oracle.objective - OBJ_TOL <= discrete.objective <= upper + OBJ_TOL
     if lattice:
         assert discrete.objective == pytest.approx(oracle.objective, abs=OBJ_TOL)
+    # the relaxed (cell) model's bound holds for continuous delays: OPT ∈ [bound, CP-SAT objective]
+    assert discrete.extras["continuous_bound"] <= oracle.objective + OBJ_TOL
+    assert discrete.extras["optimal_within"] >= discrete.objective - oracle.objective - OBJ_TOL
 
 
 @settings(max_examples=300, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])

@@ -210,8 +210,10 @@ class Schedule:
 
     def summary(self) -> dict:
         """The keys of summary.json (INTERFACES.md), plus ``model`` (what the status and bound are
-        about, e.g. a delay grid) and ``continuous_bound`` when the solver gives them."""
-        named = {key: self.extras[key] for key in ("model", "continuous_bound", "continuous_bound_model") if key in self.extras}
+        about, e.g. a delay grid), ``continuous_bound`` (a bound valid for continuous delays) and
+        ``optimal_within`` (objective − continuous_bound) when the solver gives them."""
+        named = {key: self.extras[key] for key in ("model", "continuous_bound", "continuous_bound_model", "optimal_within")
+                 if key in self.extras}
         return {
             "solver": self.solver, "status": self.status, "objective": self.objective, "bound": self.bound,
             "gap": self.gap, **named, "operated": self.operated_count, "cancelled": self.cancelled,

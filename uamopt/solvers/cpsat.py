@@ -42,6 +42,7 @@ from fractions import Fraction
 import numpy as np
 
 from uamopt.errors import UamoptError
+from uamopt.schedule.flights import TIME_TOL_S
 from uamopt.schedule.model import Schedule, SchedulingProblem, make_schedule
 
 ROUND_S = 1e-9  # float round-off accepted when rounding a real time to units, s
@@ -63,8 +64,12 @@ def _objective(problem: SchedulingProblem, unit_s: float, delay_max: np.ndarray)
     return round(float(per_unit) / top * 1e9), round(float(per_flight) / top * 1e9), 1e9 / top, "approximate"
 
 
-def build_cpsat(problem: SchedulingProblem, unit_s: float = 0.01):
-    """The CP-SAT model; returns (model, operate vars, delay vars in units, per-unit coef, per-flight coef, divisor, how)."""
+def build_cpsat(problem: SchedulingProblem, unit_s: float = 0.01, rounding: str = "outer"):
+    """The CP-SAT model; returns (model, operate vars, delay vars in units, per-unit coef, per-flight coef, divisor, how).
+
+    ``rounding = "inner"`` reads k as the *cell* [k u, (k+1) u) of a continuous delay and forbids
+    only what every point of a cell pair breaks (as timeindexed.py's ``relaxed`` model): a
+    relaxation, whose bound holds for continuous delays."""
     from ortools.sat.python import cp_model  # imported on use: see ``solve``
     from ortools.util.python.sorted_interval_list import Domain
 
@@ -82,15 +87,22 @@ def build_cpsat(problem: SchedulingProblem, unit_s: float = 0.01):
     for chain in problem.chains:
         for i, e in enumerate(chain.tolist()):
             for f in chain[i + 1:].tolist():
-                need = math.ceil((dep[e] + time[e] + gap[e] - dep[f]) / unit_s - eta)
+                need = dep[e] + time[e] + gap[e] - dep[f]
+                need = (math.ceil(need / unit_s - eta) if rounding == "outer"
+                        else math.floor((need - TIME_TOL_S) / unit_s - 1 - eta) + 1)
                 if need > -delay_max[e]:
                     model.add(delay[f] - delay[e] >= need).only_enforce_if([operate[e], operate[f]])
     pairs, ptr, intervals = problem.conflict_arrays
     for k, (p, q) in enumerate(pairs.tolist()):
         shift = dep[q] - dep[p]
         reach = Domain(-int(delay_max[p]), int(delay_max[q]))
-        forbidden = [[math.floor((lo - shift) / unit_s + eta) + 1, math.ceil((hi - shift) / unit_s - eta) - 1]
-                     for lo, hi in intervals[ptr[k]:ptr[k + 1]].tolist()]
+        if rounding == "outer":
+            forbidden = [[math.floor((lo - shift) / unit_s + eta) + 1, math.ceil((hi - shift) / unit_s - eta) - 1]
+                         for lo, hi in intervals[ptr[k]:ptr[k + 1]].tolist()]
+        else:
+            forbidden = [[math.ceil((lo + TIME_TOL_S - shift) / unit_s + 1 + eta),
+                          math.floor((hi - TIME_TOL_S - shift) / unit_s - 1 - eta)]
+                         for lo, hi in intervals[ptr[k]:ptr[k + 1]].tolist()]
         forbidden = [iv for iv in forbidden if iv[0] <= iv[1]]
         allowed = reach.intersection_with(Domain.from_intervals(forbidden).complement()) if forbidden else reach
         if allowed.is_empty():
@@ -111,31 +123,17 @@ def _bound(problem: SchedulingProblem, raw: float, per_flight: int, divisor: flo
     return s0 + unit_s * max(0.0, raw - per_flight * s0) / (float(np.sum(problem.delay_upper_s)) + 1.0)
 
 
-def solve(problem: SchedulingProblem, profile) -> Schedule:
-    """Solve the discretised model with CP-SAT; status optimal | time_limit | infeasible, from CP-SAT's
-    own termination (OPTIMAL: proved on the u-lattice model; FEASIBLE: stopped by the time limit,
-    the only limit set). Hinted with the best cheap heuristic schedule on the ΔT_a grid
-    (:mod:`~uamopt.solvers.warmstart`), and never worse than it."""
+def _solver(profile, options: dict, limit_s: float):
+    """A CpSolver with the profile's limit, threads, seed and options."""
     from ortools.sat.python import cp_model
 
-    from uamopt.solvers.warmstart import no_worse, reduced, warm_start
-
-    options = dict(profile.options)
-    unit_s = float(options.pop("time_unit_s", 0.01))
-    if not (math.isfinite(unit_s) and unit_s > 0):
-        raise UamoptError(f"time_unit_s must be a positive number of seconds, got {unit_s}",
-                          f"profile {profile.name or 'cpsat'}", "use e.g. 0.01")
-    model, operate, delay, _, per_flight, divisor, how = build_cpsat(reduced(problem), unit_s)  # dominance caps (warmstart.py)
-    start = warm_start(problem, seed=profile.seed, on_grid=True)
-    for f in range(problem.n_flights):
-        model.add_hint(operate[f], bool(start.operated[f]))
-        model.add_hint(delay[f], int(np.rint(start.delay_s[f] / unit_s)) if start.operated[f] else 0)
     solver = cp_model.CpSolver()
-    solver.parameters.max_time_in_seconds = float(profile.time_limit_s)
+    solver.parameters.max_time_in_seconds = float(limit_s)
     solver.parameters.num_workers = int(profile.threads)
     solver.parameters.random_seed = int(profile.seed)
     # CP-SAT's default small portfolios carry no max-LP worker and cannot close the bound of the
     # paper case in 60 s; with the big-M linear relaxation (level 2) they prove it in about 1 s
+    options = dict(options)
     if int(profile.threads) == 1:
         options.setdefault("linearization_level", 2)
     else:
@@ -149,12 +147,46 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
         except (AttributeError, TypeError, ValueError) as exc:
             raise UamoptError(f"unknown or invalid CP-SAT option '{key}': {exc}", f"profile {profile.name or 'cpsat'}",
                               "see ortools/sat/sat_parameters.proto") from None
+    return solver
+
+
+def solve(problem: SchedulingProblem, profile) -> Schedule:
+    """Solve the discretised model with CP-SAT; status optimal | time_limit | infeasible, from CP-SAT's
+    own termination (OPTIMAL: proved on the u-lattice model; FEASIBLE: stopped by the time limit,
+    the only limit set). Hinted with the best cheap heuristic schedule on the ΔT_a grid
+    (:mod:`~uamopt.solvers.warmstart`), and never worse than it.
+
+    Then (option ``continuous_bound``, default true) the ``inner`` model (cells of width u, a
+    relaxation) is solved, hinted with that solution, for the rest of the time limit (at least
+    1 s): its bound L is valid for continuous delays, so OPT ∈ [L, objective] and the summary gives
+    ``continuous_bound`` = L and ``optimal_within`` = objective − L (an ε proved on this instance;
+    no a-priori ε exists, since a feasible window narrower than u may hold no lattice point).
+    """
+    import time
+
+    from ortools.sat.python import cp_model
+
+    from uamopt.solvers.warmstart import no_worse, reduced, warm_start
+
+    options = dict(profile.options)
+    unit_s = float(options.pop("time_unit_s", 0.01))
+    want_bound = bool(options.pop("continuous_bound", True))
+    if not (math.isfinite(unit_s) and unit_s > 0):
+        raise UamoptError(f"time_unit_s must be a positive number of seconds, got {unit_s}",
+                          f"profile {profile.name or 'cpsat'}", "use e.g. 0.01")
+    t0 = time.perf_counter()
+    small = reduced(problem)  # dominance caps (warmstart.py): the same optima
+    model, operate, delay, _, per_flight, divisor, how = build_cpsat(small, unit_s)
+    start = warm_start(problem, seed=profile.seed, on_grid=True)
+    for f in range(problem.n_flights):
+        model.add_hint(operate[f], bool(start.operated[f]))
+        model.add_hint(delay[f], int(np.rint(start.delay_s[f] / unit_s)) if start.operated[f] else 0)
+    solver = _solver(profile, options, profile.time_limit_s)
     code = solver.solve(model)
     seconds = float(solver.wall_time)
     n = problem.n_flights
     extras = {"termination": solver.status_name(code), "time_unit_s": unit_s, "objective_scale": how,
-              "model": f"delay lattice {unit_s:g} s, constraints rounded outward (a restriction of the continuous "
-                       "model: its optimum is within the proved tolerance above the continuous one, see the docstring)",
+              "model": f"delay lattice {unit_s:g} s, constraints rounded outward (a restriction of the continuous model)",
               "branches": int(solver.num_branches), "warm_start": f"{start.source} {start.objective:.6f}"}
     if code == cp_model.MODEL_INVALID:
         raise UamoptError(f"CP-SAT rejected the model: {model.validate()}", f"profile {profile.name or 'cpsat'}",
@@ -166,8 +198,23 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
         return no_worse(problem, make_schedule(problem, "cpsat", "time_limit", np.zeros(n, bool), np.zeros(n),
                                                solve_seconds=seconds, seed=profile.seed, extras=extras), start)
     operated = np.array([solver.boolean_value(v) for v in operate])
-    delay_s = np.array([solver.value(v) for v in delay], dtype=float) * unit_s
+    delay_k = [solver.value(v) for v in delay]
+    delay_s = np.array(delay_k, dtype=float) * unit_s
     status = "optimal" if code == cp_model.OPTIMAL else "time_limit"  # FEASIBLE: stopped by the time limit
     bound = _bound(problem, solver.best_objective_bound, per_flight, divisor, unit_s, how)
-    return no_worse(problem, make_schedule(problem, "cpsat", status, operated, delay_s, bound=bound, solve_seconds=seconds,
-                                           seed=profile.seed, extras=extras), start)
+    schedule = no_worse(problem, make_schedule(problem, "cpsat", status, operated, delay_s, bound=bound,
+                                               solve_seconds=seconds, seed=profile.seed, extras=extras), start)
+    if want_bound:
+        inner, i_op, i_delay, _, i_flight, i_div, i_how = build_cpsat(small, unit_s, rounding="inner")
+        for f in range(n):  # the outer solution is a point of the relaxation
+            inner.add_hint(i_op[f], bool(operated[f]))
+            inner.add_hint(i_delay[f], int(delay_k[f]))
+        left = max(1.0, profile.time_limit_s - (time.perf_counter() - t0))
+        relaxed = _solver(profile, options, left)
+        r_code = relaxed.solve(inner)
+        if r_code in (cp_model.OPTIMAL, cp_model.FEASIBLE, cp_model.UNKNOWN):
+            low = _bound(problem, relaxed.best_objective_bound, i_flight, i_div, unit_s, i_how)
+            schedule.extras.update(continuous_bound=low, continuous_bound_termination=relaxed.status_name(r_code),
+                                   continuous_bound_model=f"delay cells {unit_s:g} s (relaxation of the continuous model)",
+                                   optimal_within=schedule.objective - low)
+    return schedule
