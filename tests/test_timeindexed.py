@@ -23,13 +23,10 @@ from conftest import PAPER_CASE
 from hypothesis import HealthCheck, given, settings
 from test_exact_solvers import tiny_problems
 
-from uamopt.grid import AirspaceGrid
-from uamopt.scenario import load_scenario
 from uamopt.schedule import (
     build_problem,
     evaluate,
     generate_plan,
-    straight_network,
     violations,
     write_schedule,
 )
@@ -64,7 +61,7 @@ def test_grid_model_is_exact_on_its_grid_and_relaxed_bounds_the_continuous_optim
     _, problem = case
     step = 5.0  # delays ≤ 20 s: at most 5 grid points and "cancel" per flight
     expected = grid_enumeration(problem, step)
-    for engine in ("highs", "cpsat"):
+    for engine in ("highs", "cpsat", "hybrid"):
         grid = solve(problem, ti(step_s=step, engine=engine))
         assert grid.status == "optimal" and violations(problem, grid.operated, grid.delay_s) == []
         assert grid.objective == pytest.approx(expected, abs=OBJ_TOL)
@@ -78,10 +75,9 @@ def test_grid_model_is_exact_on_its_grid_and_relaxed_bounds_the_continuous_optim
 
 
 @pytest.fixture(scope="module")
-def paper_problem():
-    scenario = load_scenario(PAPER_CASE)
-    grid = AirspaceGrid.from_extent(scenario.grid.cell, scenario.grid.extent)
-    return build_problem(generate_plan(scenario, straight_network(scenario, grid), seed=0), scenario)
+def paper_problem(paper_straight_plan):
+    scenario, _, _, plan = paper_straight_plan
+    return build_problem(plan, scenario)
 
 
 def test_exact_profile_on_the_paper_case(paper_problem, tmp_path):
@@ -103,10 +99,9 @@ def test_exact_profile_on_the_paper_case(paper_problem, tmp_path):
 
 
 @pytest.fixture(scope="module")
-def medium_problem():
-    scenario = load_scenario(PAPER_CASE)
-    grid = AirspaceGrid.from_extent(scenario.grid.cell, scenario.grid.extent)
-    return build_problem(generate_plan(scenario, straight_network(scenario, grid), seed=1, aircraft=40), scenario)
+def medium_problem(paper_straight_plan):
+    scenario, _, network, _ = paper_straight_plan
+    return build_problem(generate_plan(scenario, network, seed=1, aircraft=40), scenario)
 
 
 @pytest.mark.parametrize("profile", [
@@ -115,7 +110,8 @@ def medium_problem():
     SolverProfile("rolling", time_limit_s=0.05, threads=1, options={"window_s": 900.0}),
     SolverProfile("timeindexed", time_limit_s=0.05, threads=1),
     SolverProfile("timeindexed", time_limit_s=0.05, threads=1, options={"engine": "cpsat"}),
-], ids=["highs", "cpsat", "rolling", "timeindexed-highs", "timeindexed-cpsat"])
+    SolverProfile("timeindexed", time_limit_s=0.05, threads=1, options={"engine": "hybrid"}),
+], ids=["highs", "cpsat", "rolling", "timeindexed-highs", "timeindexed-cpsat", "timeindexed-hybrid"])
 def test_exact_solvers_never_worse_than_greedy_at_a_tiny_limit(medium_problem, profile, tmp_path):
     problem = medium_problem
     greedy = evaluate(problem, *greedy_decisions(problem))

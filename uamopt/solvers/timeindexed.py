@@ -41,11 +41,14 @@ objective: no optimum changes), which shrinks the model several-fold.
 Engines: ``engine = "highs"`` (highspy directly; MIP start from :mod:`warmstart` via
 ``setSolution``) or ``"cpsat"`` (OR-Tools CP-SAT on the same 0-1 model: at-most-one rows, the
 objective scaled to integers exactly as in cpsat.py; hints from the warm start; pair rows written
-from both sides) or ``"auto"`` (default: HiGHS up to ``AUTO_HIGHS_COLUMNS`` columns, else CP-SAT —
-HiGHS proved the 300- and 600-flight rungs optimal but found no dual bound at 1,000 in 300 s).
+from both sides), ``"hybrid"`` (HiGHS without presolve for ``HYBRID_HIGHS_SHARE`` of the time —
+it finds good incumbents fast — then CP-SAT hinted with HiGHS's best, whose clique-merged LP gives
+the far better bound; the better incumbent and the larger bound of the two, both of this model) or
+``"auto"`` (default: HiGHS up to ``AUTO_HIGHS_COLUMNS`` columns, else hybrid — HiGHS proved the
+300- and 600-flight rungs optimal, but at 1,000 its presolve used the whole 300 s).
 
 Options: ``step_s`` (s, default 10), ``model`` ("grid" | "relaxed", default "grid"), ``engine``
-("auto" | "highs" | "cpsat", default "auto"), ``warm_soa_s`` (seconds of SOA in the warm start, default 0),
+("auto" | "highs" | "cpsat" | "hybrid", default "auto"), ``warm_soa_s`` (seconds of SOA in the warm start, default 0),
 ``continuous_bound_s`` (default 0: seconds to spend after a ``grid`` solve on the ``relaxed``
 model at ``continuous_bound_step_s`` (default ``step_s``), whose bound is reported as
 ``extras["continuous_bound"]``), ``mip_rel_gap`` (default 0). The summary names the model:
@@ -70,7 +73,8 @@ from uamopt.solvers.warmstart import Start, no_worse, reduced, warm_start
 
 KNOWN = {"step_s", "model", "engine", "warm_soa_s", "continuous_bound_s", "continuous_bound_step_s", "mip_rel_gap"}
 ETA_S = 1e-9  # float round-off accepted when rounding a time to grid steps, s
-AUTO_HIGHS_COLUMNS = 8000  # engine "auto": HiGHS up to this many columns, CP-SAT above
+AUTO_HIGHS_COLUMNS = 8000  # engine "auto": HiGHS up to this many columns, "hybrid" above
+HYBRID_HIGHS_SHARE = 0.3  # engine "hybrid": this share of the time to HiGHS (no presolve), the rest to CP-SAT
 
 
 @dataclass(frozen=True)
@@ -220,7 +224,8 @@ class EngineResult:
     best_incumbent_s: float | None = None
 
 
-def _highs(model: GridModel, limit_s: float, threads: int, seed: int, gap: float, hint: np.ndarray | None) -> EngineResult:
+def _highs(model: GridModel, limit_s: float, threads: int, seed: int, gap: float, hint: np.ndarray | None,
+           presolve: bool = True) -> EngineResult:
     import highspy
 
     h = highspy.Highs()
@@ -230,6 +235,8 @@ def _highs(model: GridModel, limit_s: float, threads: int, seed: int, gap: float
     h.setOptionValue("threads", int(threads))
     h.setOptionValue("random_seed", int(seed))
     h.setOptionValue("mip_rel_gap", float(gap))
+    if not presolve:  # at 1,000 flights HiGHS's presolve took the whole limit; without it HiGHS finds incumbents fast
+        h.setOptionValue("presolve", "off")
     n = model.n_cols
     inf = highspy.kHighsInf
     h.addVars(n, np.zeros(n), np.ones(n))
@@ -261,7 +268,7 @@ def _highs(model: GridModel, limit_s: float, threads: int, seed: int, gap: float
     x = np.array(sol.col_value) if sol.value_valid else None
     if hint is not None and x is not None and abs(float(model.cost @ x) - info.objective_function_value) > 1e-6 * (
             1.0 + abs(info.objective_function_value)):  # a solution that is not the one reported: trust neither
-        return _highs(model, limit_s, threads, seed, gap, None)
+        return _highs(model, limit_s, threads, seed, gap, None, presolve)
     proved = status == highspy.HighsModelStatus.kOptimal
     bound = float(info.mip_dual_bound) if math.isfinite(info.mip_dual_bound) else None
     if proved and x is not None:
@@ -324,7 +331,21 @@ def run_engine(engine: str, model: GridModel, problem: SchedulingProblem, limit_
         return _highs(model, limit_s, threads, seed, gap, hint)
     if engine == "cpsat":
         return _cpsat(model, problem, limit_s, threads, seed, gap, hint)
-    raise UamoptError(f"unknown engine '{engine}'", "solver timeindexed", "use engine = \"highs\" or \"cpsat\"")
+    if engine == "hybrid":  # HiGHS without presolve for incumbents, then CP-SAT from its best for the bound
+        first = _highs(model, HYBRID_HIGHS_SHARE * limit_s, threads, seed, gap, hint, presolve=False)
+        if first.proved:
+            return first
+        start = first.x if first.x is not None else hint
+        second = _cpsat(model, problem, (1 - HYBRID_HIGHS_SHARE) * limit_s, threads, seed, gap, start)
+        xs = [r.x for r in (first, second) if r.x is not None]
+        x = min(xs, key=lambda v: float(model.cost @ v)) if xs else None
+        bounds = [b for b in (first.bound, second.bound) if b is not None]  # both bound the same model
+        best_t = second.best_incumbent_s if x is second.x and second.best_incumbent_s is not None else first.best_incumbent_s
+        return EngineResult(x=x, bound=max(bounds) if bounds else None, proved=first.proved or second.proved,
+                            termination=f"highs: {first.termination}; cpsat: {second.termination}",
+                            seconds=first.seconds + second.seconds, first_incumbent_s=first.first_incumbent_s,
+                            best_incumbent_s=(best_t + (first.seconds if x is second.x else 0.0)) if best_t is not None else None)
+    raise UamoptError(f"unknown engine '{engine}'", "solver timeindexed", "use engine = \"auto\", \"highs\", \"cpsat\" or \"hybrid\"")
 
 
 # --- the solver ------------------------------------------------------------------------------------
@@ -341,7 +362,7 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
     start: Start = warm_start(problem, step, soa_s=float(o.get("warm_soa_s", 0.0)), seed=profile.seed, on_grid=True)
     small = reduced(problem)  # dominance caps: the same optima (warmstart.py)
     if engine == "auto":  # measured (docs/exact_scheduling.md): HiGHS proves ≤ 600 flights, CP-SAT gets further beyond
-        engine = "highs" if int(np.sum(np.floor(small.delay_upper_s / step) + 1)) <= AUTO_HIGHS_COLUMNS else "cpsat"
+        engine = "highs" if int(np.sum(np.floor(small.delay_upper_s / step) + 1)) <= AUTO_HIGHS_COLUMNS else "hybrid"
     model = build_grid_model(small, step, kind, both_ways=engine == "cpsat")
     built = time.perf_counter() - t0
     hint = model.columns_of(start.operated, start.delay_s) if kind == "grid" else None
