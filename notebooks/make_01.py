@@ -10,7 +10,7 @@ cells = [
 
 This notebook builds the operational risk field of `models/paper_case.toml` stage by stage
 (scenario → city layers → airspace grid → risk field), checks the physical models against the
-reference numbers of `MODEL_NOTES.md`, draws the risk map and reports the share of unsafe cells
+reference numbers of `docs/readings.md`, draws the risk map and reports the share of unsafe cells
 per altitude layer.
 
 Executed by `tests/test_notebooks.py`: every `assert` below is a check, so a clean run means the
@@ -58,8 +58,8 @@ For a fall from rest through $h'$ = 148.2 m with quadratic drag:
   $P^P = 1/\\bigl(1 + \\sqrt{\\alpha/\\beta}\\,(\\beta/E_{imp})^{1/(4c_s)}\\bigr)$ (Eq. 3);
 - $R^P = \\lambda N^P P^P$ with $N^P = \\rho_P S_e$ (Eqs. 1–2).
 
-The reference column is `MODEL_NOTES.md`, copied as printed. Each value is asserted to 10⁻⁶
-relative, or to half a unit of the last printed digit where the notes print fewer digits than
+The reference column is `docs/readings.md` (Reference numbers), copied as printed. Each value is asserted to 10⁻⁶
+relative, or to half a unit of the last printed digit where the reference prints fewer digits than
 that (the terminal speeds, 5 significant digits, and P^P at c_s = 0.75 for 220 kg, which rounds
 0.1465352 to 0.146535). The terminal speed is also asserted to 10⁻¹² against the closed form
 $\\sqrt{2(m_e+m_p)g/(R_I\\rho_a S_e)}$."""),
@@ -67,7 +67,7 @@ $\\sqrt{2(m_e+m_p)g/(R_I\\rho_a S_e)}$."""),
 g = r.gravity_mps2
 area = crash_area(a.length_m)
 height = 148.2  # h', m
-reference = {  # MODEL_NOTES.md as printed, (m_p = 0 kg, m_p = 220 kg)
+reference = {  # docs/readings.md as printed, (m_p = 0 kg, m_p = 220 kg)
     "terminal speed (m/s)": ("27.468", "34.198"),
     "v from 148.2 m, A.3 (m/s)": ("27.174496", "32.740228"),
     "fall time from 148.2 m (s)": ("7.323078", "6.677222"),
@@ -107,7 +107,7 @@ for column, payload in enumerate((0.0, 220.0)):
         ref = float(printed)
         assert abs(value - ref) <= tolerance(printed), (name, payload, value, printed)
         rows.append({"quantity": name, "m_p (kg)": f"{payload:g}", "uamopt": f"{value:.8g}",
-                     "MODEL_NOTES": printed, "relative difference": f"{abs(value - ref) / abs(ref):.1e}"})
+                     "reference": printed, "relative difference": f"{abs(value - ref) / abs(ref):.1e}"})
 table = (pd.DataFrame(rows).set_index(["quantity", "m_p (kg)"]).unstack("m_p (kg)")
          .swaplevel(axis=1).sort_index(axis=1, level=0, sort_remaining=False).reindex(list(reference)))
 table"""),

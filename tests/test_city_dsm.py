@@ -53,8 +53,9 @@ def _utm(points: list[tuple[float, float]]) -> list[list[float]]:
     return [[LEFT + x, BOTTOM + y] for x, y in points]
 
 
-@pytest.fixture
-def dsm_dir(tmp_path: Path) -> Path:
+def write_dsm_city(tmp_path: Path) -> Path:
+    """The test city of the module docstring in ``tmp_path`` (city.toml, dsm.tif, roads, no-fly)."""
+    tmp_path.mkdir(parents=True, exist_ok=True)
     dsm = np.full((HEIGHT, WIDTH), 10.0)
     _block(dsm, (20, 60), (220, 240), 50.0)
     _block(dsm, (140, 160), (40, 80), 22.0)
@@ -73,6 +74,20 @@ def dsm_dir(tmp_path: Path) -> Path:
         '[city]\nsource = "dsm"\ndsm = "dsm.tif"\nroads = "roads.geojson"\nno_fly = "no_fly.geojson"\n'
     )
     return tmp_path
+
+
+@pytest.fixture
+def dsm_dir(tmp_path: Path) -> Path:
+    return write_dsm_city(tmp_path)
+
+
+def dsm_city_with_every_layer(directory: Path) -> Path:
+    """The test city with every optional [city] key of the dsm source set; returns its city.toml."""
+    write_dsm_city(directory)
+    _write_tif(directory / "shelter.tif", np.full((HEIGHT, WIDTH), 0.4), nodata=None)
+    toml = directory / "city.toml"
+    toml.write_text(toml.read_text() + 'shelter = "shelter.tif"\nground_m = 9.0\nbuilding_min_height_m = 3.0\n')
+    return toml
 
 
 def _layers(directory: Path, overrides: list[str] | None = None):
@@ -173,3 +188,22 @@ def test_no_dsm_given(dsm_dir):
     (dsm_dir / "bare.toml").write_text('[city]\nsource = "dsm"\n')
     with pytest.raises(ScenarioError, match="city.dsm"):
         dsm_extent(load_scenario(dsm_dir / "bare.toml"))
+
+
+def test_low_patch_is_an_obstacle_but_not_a_clearance_source(dsm_dir):
+    """Eq. 15 measures s_min from building cells: a 6 m patch below building_min_height_m = 8 m is an
+    obstacle the track cannot enter, but the cell 10 m above it stays admissible."""
+    from uamopt.planning import planning_model
+    from uamopt.stages import compute_risk
+
+    band = ["aircraft.h_min=0.0", "grid.h_min_airspace=0.0", "city.ground_m=4.0"]
+
+    def model(min_height: float):
+        scenario = load_scenario(dsm_dir / "city.toml", band + [f"city.building_min_height_m={min_height}"])
+        return planning_model(scenario, compute_risk(scenario).field)
+
+    low = model(8.0)  # the ground between the blocks stands 6 m above the datum: a low patch
+    assert low.field.obstacle[4, 7, 0] and low.field.city.building_height[4, 7] == 0.0
+    assert low.admissible[4, 7, 1] and not low.admissible[4, 7, 0]
+    tall = model(2.0)  # the same 6 m surface counted as buildings: 10 m above is within s_min = 50 m
+    assert tall.field.city.building_height[4, 7] == pytest.approx(6.0) and not tall.admissible[4, 7, 1]

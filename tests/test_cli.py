@@ -1,4 +1,9 @@
-"""End-to-end: the commands as a user runs them, and the one-line errors of INTERFACES.md."""
+"""The commands as a user runs them, and the one-line errors of docs/interfaces.md.
+
+Most tests call ``uamopt.cli.main([...])`` in this process (capsys holds stdout and stderr; an
+argparse error raises SystemExit(2)); a few run the installed entry points in a subprocess to prove
+that ``python -m uamopt`` and the ``uamopt`` script reach the same code with the same exit codes.
+"""
 
 from __future__ import annotations
 
@@ -9,21 +14,39 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import PAPER_CASE, ROOT
 
-ROOT = Path(__file__).resolve().parents[1]
-PAPER = str(ROOT / "models" / "paper_case.toml")
+from uamopt.cli import main
+
+PAPER = str(PAPER_CASE)
+UAMOPT_SCRIPT = Path(sys.executable).with_name("uamopt")
 
 
-def run(*args: str, cwd: Path = ROOT) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "uamopt", *args], cwd=cwd, capture_output=True, text=True, timeout=300)
+def run(*args: str) -> subprocess.CompletedProcess:
+    """``python -m uamopt ARGS`` in a fresh interpreter."""
+    return subprocess.run([sys.executable, "-m", "uamopt", *args], cwd=ROOT, capture_output=True, text=True, timeout=300)
 
 
-def assert_one_line_error(proc: subprocess.CompletedProcess, fragment: str) -> None:
-    assert proc.returncode == 2, proc.stderr
-    lines = proc.stderr.strip().splitlines()
-    assert len(lines) == 1, proc.stderr
+def cli(capsys, *args: str) -> tuple[int, str, str]:
+    """``uamopt ARGS`` in this process: (exit code, stdout, stderr)."""
+    try:
+        code = main(list(args))
+    except SystemExit as exc:  # argparse: --help, --version, bad arguments
+        code = exc.code
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def assert_one_line_error(code: int, stderr: str, fragment: str) -> None:
+    assert code == 2, stderr
+    lines = stderr.strip().splitlines()
+    assert len(lines) == 1, stderr
     assert lines[0].startswith("error: ") and fragment in lines[0], lines[0]
-    assert "Traceback" not in proc.stderr
+    assert " (" in lines[0] and "): " in lines[0]  # what (where): how to fix
+    assert "Traceback" not in stderr
+
+
+# --- end to end through the installed entry points ---------------------------------------------
 
 
 def test_risk_command_writes_the_interface_files(tmp_path):
@@ -42,23 +65,24 @@ def test_risk_command_writes_the_interface_files(tmp_path):
     assert (out / "risk.png").stat().st_size > 10_000
 
 
-def test_reproduce_writes_the_report(tmp_path):
-    out = tmp_path / "paper"
-    proc = run("reproduce", PAPER, "--out", str(out), "--set", "tracks.table2_cell_m=25", "--set", "tracks.table4_cells=[]")
-    assert proc.returncode == 0, proc.stderr
-    assert "report.md" in proc.stdout
-    report = (out / "report.md").read_text()
-    assert "Operational risk field" in report and "![risk map](risk.png)" in report
-    assert "27.4684" in report  # terminal speed at m_p = 0 beside the reference 27.468
-    assert "Table 2 analogue" in report and "Route network" in report
-    expected = {"risk.npz", "risk.png", "summary.json", "report.md", "tracks.json", "tracks.png", "network.json", "network.png"}
-    assert expected <= {p.name for p in out.iterdir()}
+def test_entry_points_exit_codes_and_one_line_errors(tmp_path):
+    script = subprocess.run([str(UAMOPT_SCRIPT), "--help"], capture_output=True, text=True, timeout=120)
+    assert script.returncode == 0 and "reproduce" in script.stdout
+    bad = subprocess.run([str(UAMOPT_SCRIPT), "risk", str(tmp_path / "none.toml"), "--out", str(tmp_path / "o")],
+                         capture_output=True, text=True, timeout=120)
+    assert_one_line_error(bad.returncode, bad.stderr, "not found")
+    module = run("frobnicate", PAPER)
+    assert_one_line_error(module.returncode, module.stderr, "command line")
+    assert not (tmp_path / "o").exists()
 
 
-def test_plan_command(tmp_path):
+# --- the commands, in process -----------------------------------------------------------------
+
+
+def test_plan_command(tmp_path, capsys):
     out = tmp_path / "plan"
-    proc = run("plan", PAPER, "--from", "300,300,120", "--to", "2220,4220,120", "--out", str(out))
-    assert proc.returncode == 0, proc.stderr
+    code, stdout, err = cli(capsys, "plan", PAPER, "--from", "300,300,120", "--to", "2220,4220,120", "--out", str(out))
+    assert code == 0, err
     doc = json.loads((out / "tracks.json").read_text())
     assert list(doc["stages"]) == ["shortest", "initial", "equivalent", "optimal"]
     for stage in doc["stages"].values():
@@ -66,15 +90,17 @@ def test_plan_command(tmp_path):
         assert stage["n_waypoints"] == len(pts)
         assert stage["length_m"] == pytest.approx(float(np.linalg.norm(np.diff(pts, axis=0), axis=1).sum()))
     assert doc["stages"]["optimal"]["waypoints"][0] == [300.0, 300.0, 120.0]
+    assert f"{doc['stages']['optimal']['length_m']:.0f} m" in stdout
     assert (out / "tracks.png").stat().st_size > 10_000
 
 
-def test_network_command(tmp_path):
+def test_network_command(tmp_path, capsys):
     out = tmp_path / "net"
-    proc = run("network", PAPER, "--out", str(out))
-    assert proc.returncode == 0, proc.stderr
+    code, stdout, err = cli(capsys, "network", PAPER, "--out", str(out))
+    assert code == 0, err
     doc = json.loads((out / "network.json").read_text())
     assert len(doc["routes"]) == 20 and doc["routes"]["V1-V4"]["origin"] == "V1"
+    assert "network: 20 tracks" in stdout
 
 
 @pytest.mark.parametrize("args, fragment", [
@@ -83,13 +109,13 @@ def test_network_command(tmp_path):
     (["--from", "9000,300,120"], "outside the grid"),
     (["--set", "aircraft.range_m=2000"], "range"),
 ])
-def test_plan_bad_input(tmp_path, args, fragment):
+def test_plan_bad_input(tmp_path, capsys, args, fragment):
     out = tmp_path / "o"
-    assert_one_line_error(run("plan", PAPER, "--out", str(out), *args), fragment)
+    assert_one_line_error(*cli(capsys, "plan", PAPER, "--out", str(out), *args)[::2], fragment)
     assert not out.exists()
 
 
-def test_plan_origin_in_building_and_unreachable_destination(tmp_path):
+def test_plan_origin_in_building_and_unreachable_destination(tmp_path, capsys):
     """A DSM city with a closed ring of 320 m towers: inside a tower, and inside the ring."""
     import rasterio
     from rasterio.transform import from_origin
@@ -105,26 +131,27 @@ def test_plan_origin_in_building_and_unreachable_destination(tmp_path):
     scenario.write_text(f"[grid]\ncell = [20.0, 20.0, 30.0]\n[city]\nsource = 'dsm'\ndsm = '{path}'\n"
                         "[tracks]\nclearance_m = 0.0\n")
     out = tmp_path / "o"
-    assert_one_line_error(run("plan", str(scenario), "--from", "30,30,120", "--to", "120,120,135", "--out", str(out)),
-                          "inside a building")
-    assert_one_line_error(run("plan", str(scenario), "--from", "30,30,120", "--to", "200,200,120", "--out", str(out)),
-                          "no admissible track")
+    assert_one_line_error(*cli(capsys, "plan", str(scenario), "--from", "30,30,120", "--to", "120,120,135",
+                               "--out", str(out))[::2], "inside a building")
+    assert_one_line_error(*cli(capsys, "plan", str(scenario), "--from", "30,30,120", "--to", "200,200,120",
+                               "--out", str(out))[::2], "no admissible track")
     assert not out.exists()
 
 
-def test_helsinki_from_openstreetmap(tmp_path):
+def test_helsinki_from_openstreetmap(tmp_path, capsys):
     out = tmp_path / "hel"
-    proc = run("risk", str(ROOT / "models" / "helsinki.toml"), "--out", str(out), "--set", "grid.cell=[40,40,30]")
-    assert proc.returncode == 0, proc.stderr
+    code, _, err = cli(capsys, "risk", str(ROOT / "models" / "helsinki.toml"), "--out", str(out),
+                       "--set", "grid.cell=[40,40,30]")
+    assert code == 0, err
     summary = json.loads((out / "summary.json").read_text())
     assert summary["source"] == "osm" and "OpenStreetMap" in summary["attribution"]
     assert summary["obstacle_cells"] > 0 and summary["unsafe_share"] > 0
 
 
-def test_same_seed_same_field(tmp_path):
+def test_same_seed_same_field(tmp_path, capsys):
     a, b = tmp_path / "a", tmp_path / "b"
     for out in (a, b):
-        assert run("risk", PAPER, "--out", str(out), "--set", "grid.cell=[100,100,60]").returncode == 0
+        assert cli(capsys, "risk", PAPER, "--out", str(out), "--set", "grid.cell=[100,100,60]")[0] == 0
     with np.load(a / "risk.npz") as x, np.load(b / "risk.npz") as y:
         for name in x.files:
             assert np.array_equal(x[name], y[name], equal_nan=True), name
@@ -148,65 +175,25 @@ def bad_toml(tmp_path):
     ("[city]\nsource = 'dsm'\ndsm = 'missing.tif'", [], "missing.tif"),
     ("", ["grid.cell=[10,10,-1]"], "--set grid.cell"),
 ])
-def test_bad_input_one_line_exit_2_nothing_written(tmp_path, bad_toml, text, extra, fragment):
+def test_bad_input_one_line_exit_2_nothing_written(tmp_path, capsys, bad_toml, text, extra, fragment):
     out = tmp_path / "out"
     args = ["risk", bad_toml(text), "--out", str(out)]
     for item in extra:
         args += ["--set", item]
-    proc = run(*args)
-    assert_one_line_error(proc, fragment)
+    assert_one_line_error(*cli(capsys, *args)[::2], fragment)
     assert not out.exists()
 
 
-def test_missing_scenario_and_bad_arguments(tmp_path):
-    assert_one_line_error(run("risk", str(tmp_path / "none.toml"), "--out", str(tmp_path / "o")), "not found")
-    assert_one_line_error(run("risk"), "command line")
-    assert_one_line_error(run("frobnicate", PAPER), "command line")
+def test_missing_scenario_and_bad_arguments(tmp_path, capsys):
+    assert_one_line_error(*cli(capsys, "risk", str(tmp_path / "none.toml"), "--out", str(tmp_path / "o"))[::2],
+                          "not found")
+    assert_one_line_error(*cli(capsys, "risk")[::2], "command line")
+    assert_one_line_error(*cli(capsys, "frobnicate", PAPER)[::2], "command line")
+    assert_one_line_error(*cli(capsys, "schedule", PAPER, "--solver", "highs", "--seed", "x")[::2], "command line")
 
 
-def test_out_is_a_file(tmp_path):
+def test_out_is_a_file(tmp_path, capsys):
     target = tmp_path / "file.txt"
     target.write_text("keep me")
-    assert_one_line_error(run("risk", PAPER, "--out", str(target)), "output path is a file")
+    assert_one_line_error(*cli(capsys, "risk", PAPER, "--out", str(target))[::2], "output path is a file")
     assert target.read_text() == "keep me"
-
-
-def test_schedule_verify_and_bench(tmp_path):
-    out = tmp_path / "sched"
-    proc = run("schedule", PAPER, "--solver", "highs", "--out", str(out))
-    assert proc.returncode == 0, proc.stderr
-    summary = json.loads((out / "summary.json").read_text())
-    assert summary["status"] == "optimal" and summary["operated"] + summary["cancelled"] == 120
-    assert summary["avg_delay_s"] == pytest.approx(summary["total_delay_s"] / 20)
-    lines = (out / "schedule.csv").read_text().splitlines()
-    assert lines[0] == "flight,aircraft,route,operated,planned_departure_s,delay_s,departure_s,arrival_s"
-    assert len(lines) == 121
-    assert run("verify", str(out)).returncode == 0
-    # plant a conflict: run two flights on one route at the same time -> the verifier exits 1
-    rows = [l.split(",") for l in lines[1:]]
-    first = next(r for r in rows if r[3] == "1")
-    twin = next(r for r in rows if r[2] == first[2] and r[0] != first[0] and r[1] != first[1])
-    twin[3], twin[5], twin[6] = "1", "0.0", first[6]
-    twin[4] = str(float(first[6]))
-    twin[7] = str(float(first[7]))
-    (out / "schedule.csv").write_text("\n".join([lines[0]] + [",".join(r) for r in rows]) + "\n")
-    bad = run("verify", str(out))
-    assert bad.returncode == 1 and bad.stdout.strip()
-    bench = tmp_path / "bench"
-    proc = run("bench", PAPER, "--solver", "greedy", "cpsat", "--out", str(bench))
-    assert proc.returncode == 0, proc.stderr
-    csv_rows = (bench / "bench.csv").read_text().splitlines()
-    assert len(csv_rows) == 3 and csv_rows[1].endswith("yes") and csv_rows[2].endswith("yes")
-    assert (bench / "bench.md").exists()
-
-
-def test_schedule_bad_input(tmp_path):
-    flights = tmp_path / "flights.json"
-    flights.write_text(json.dumps({"cell": [50, 50, 30], "conflict_radius": 1, "flights": [
-        {"id": "f1", "aircraft": "A", "route": "V9-V1", "origin": "V9", "destination": "V1", "speed_mps": 25,
-         "planned_departure_s": 0, "max_delay_s": 100}]}))
-    out = tmp_path / "o"
-    assert_one_line_error(run("schedule", PAPER, "--solver", "greedy", "--flights", str(flights), "--out", str(out)),
-                          "unknown route")
-    assert_one_line_error(run("schedule", PAPER, "--solver", "nosuch", "--out", str(out)), "solver profile not found")
-    assert not out.exists()

@@ -10,13 +10,11 @@ import numpy as np
 import pytest
 
 from uamopt.graph import neighbour_moves, to_networkx
-from uamopt.scenario import load_scenario
-from uamopt.stages import compute_risk
 
 
 @pytest.fixture(scope="module")
-def coarse(root):
-    return compute_risk(load_scenario(root / "models" / "paper_case.toml", ["grid.cell=[100,100,60]"])).field
+def coarse(coarse_run):
+    return coarse_run.field
 
 
 def test_nodes_are_the_passable_cells_with_attributes(coarse):
@@ -74,5 +72,5 @@ def test_shortest_path_on_the_graph_is_a_valid_track(coarse):
 def test_neighbourhood_choice(coarse):
     g6, g26 = to_networkx(coarse, neighbourhood=6), to_networkx(coarse, neighbourhood=26)
     assert g6.number_of_nodes() == g26.number_of_nodes() and g6.number_of_edges() < g26.number_of_edges()
-    with pytest.raises(ValueError):
+    with pytest.raises(ValueError, match="neighbourhood must be 6, 18 or 26, got 8"):
         to_networkx(coarse, neighbourhood=8)

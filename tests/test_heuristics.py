@@ -4,27 +4,19 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from conftest import PAPER_CASE
+from checks import OBJ_TOL, assert_verified
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from instances import crossing_problem
+from oracles import objective
 
 from uamopt.errors import UamoptError
-from uamopt.grid import AirspaceGrid
-from uamopt.scenario import load_scenario
-from uamopt.schedule import (
-    Flight,
-    FlightSet,
-    build_problem,
-    evaluate,
-    straight_network,
-    violations,
-    write_schedule,
-)
-from uamopt.schedule.verify import verify_dir
-from uamopt.solvers import SolverProfile, solve
+from uamopt.schedule import Flight, FlightSet, build_problem, violations
+from uamopt.solvers import SolverProfile, bruteforce, solve
 from uamopt.solvers.calibration import paper_case_plan
 from uamopt.solvers.genetic import fitness, objective_values
 from uamopt.solvers.greedy import CANCEL, decoder_for, greedy_decisions
+from uamopt.solvers.rolling import pair_matching_bound
 
 EAST = np.array([[25.0, 25.0, 45.0], [525.0, 25.0, 45.0]])  # 500 m along one row of 50 m cells: 20 s at 25 m/s
 WEST = np.array([[525.0, 25.0, 105.0], [25.0, 25.0, 105.0]])  # the way back, two layers up (no conflict with EAST)
@@ -79,106 +71,113 @@ def test_greedy_cancels_beyond_the_threshold_with_its_return():
     assert exact.operated.all() and exact.delay_s.tolist() == pytest.approx([0.0, 4.0, 4.0])
 
 
-def test_genetic_on_a_small_instance_beats_or_matches_greedy():
-    problem = _problem(*(_flight(f"{g}1", g, EAST, 0.0) for g in "ABCD"))
+# (objective, weights, W of greedy, W of the best schedule on the 10 s grid, W of the optimum):
+# weighted (ω6, ω7) = (0.1, 0.9), G = 3: −0.9·1;  0.1·10/3 − 0.9·3;  0.1·6/3 − 0.9·3
+# lexicographic, ΣU = 400: −1;  −3 + 10/401;  −3 + 6/401
+CROSSING = [
+    ("weighted", (0.1, 0.9), -0.9, 0.1 * 10 / 3 - 2.7, 0.1 * 6 / 3 - 2.7),
+    ("lexicographic", (0.6, 0.4), -1.0, -3 + 10 / 401, -3 + 6 / 401),
+]
+
+
+@pytest.mark.parametrize("objective, weights, w_greedy, w_grid, w_optimum", CROSSING)
+def test_genetic_beats_greedy_where_greedy_is_suboptimal(objective, weights, w_greedy, w_grid, w_optimum):
+    problem = crossing_problem(objective, weights)
+    np.testing.assert_allclose([c.intervals[0] for c in problem.conflicts], [[-4.0, 8.0], [4.0, 15.0]])
     greedy = solve(problem, SolverProfile("greedy"))
+    assert greedy.operated.tolist() == [True, False, False] and greedy.objective == pytest.approx(w_greedy)
+    optimum = bruteforce.solve(problem)
+    assert optimum.objective == pytest.approx(w_optimum) and optimum.delay_s.tolist() == pytest.approx([6.0, 0.0, 0.0])
     for solver in ("ga", "soa"):
-        result = solve(problem, SolverProfile(solver, options={"generations": 20, "population": 10}))
-        assert result.objective <= greedy.objective + 1e-12
-        assert violations(problem, result.operated, result.delay_s) == []
-
-
-@pytest.fixture(scope="module")
-def paper_problem():
-    scenario = load_scenario(PAPER_CASE)
-    grid = AirspaceGrid.from_extent(scenario.grid.cell, scenario.grid.extent)
-    return build_problem(paper_case_plan(scenario, straight_network(scenario, grid), seed=0), scenario)
+        for seed in (0, 1, 2):  # Table B.3's population 50 and l = 200 generations: ~0.15 s each here
+            result = solve(problem, SolverProfile(solver, seed=seed))
+            # all three operated, A1 delayed one ΔT_a step: better than greedy by two flights less the delay
+            assert result.operated.all() and result.delay_s.tolist() == [10.0, 0.0, 0.0], (solver, seed)
+            assert result.objective == pytest.approx(w_grid) and result.objective <= w_greedy - 1.0
+            assert_verified(problem, result)
 
 
 SHORT = {"generations": 40}
 
 
 @pytest.fixture(scope="module")
-def paper_results(paper_problem):
+def paper_results(calibrated_problem):
     return {
-        "greedy": solve(paper_problem, SolverProfile("greedy")),
-        "greedy_exact": solve(paper_problem, SolverProfile("greedy", options={"exact_gaps": True})),
-        "ga": solve(paper_problem, SolverProfile("ga", seed=3, options=SHORT)),
-        "soa": solve(paper_problem, SolverProfile("soa", seed=3, options=SHORT)),
-        "soa_exact": solve(paper_problem, SolverProfile("soa", seed=3, options=SHORT | {"exact_gaps": True})),
+        "greedy": solve(calibrated_problem, SolverProfile("greedy")),
+        "greedy_exact": solve(calibrated_problem, SolverProfile("greedy", options={"exact_gaps": True})),
+        "ga": solve(calibrated_problem, SolverProfile("ga", seed=3, options=SHORT)),
+        "soa": solve(calibrated_problem, SolverProfile("soa", seed=3, options=SHORT)),
+        "soa_exact": solve(calibrated_problem, SolverProfile("soa", seed=3, options=SHORT | {"exact_gaps": True})),
     }
 
 
-def test_calibrated_paper_plan_greedy_figures(paper_results):
-    """The calibration (uamopt/solvers/calibration.py): seed 0 gives 104 operated, 16 cancelled, 2260 s."""
+# Regression values, not the paper's (Table 3 has 109 / 11 / 2401 s on its own, unpublished plan):
+# what this code's preliminary strategy gave on the calibrated plan, seed 0, when the calibration
+# was chosen (uamopt/solvers/calibration.py). A change here means the plan or greedy changed.
+REGRESSION_GREEDY_SEED0 = (104, 16, 2260.0)  # operated, cancelled, total delay (s)
+
+
+def test_calibrated_paper_plan_greedy_regression(paper_results):
     greedy = paper_results["greedy"]
-    assert (greedy.operated_count, greedy.cancelled, greedy.total_delay_s) == (104, 16, 2260.0)
+    assert (greedy.operated_count, greedy.cancelled, greedy.total_delay_s) == REGRESSION_GREEDY_SEED0
     assert np.all(np.mod(greedy.delay_s, 10.0) == 0.0)  # whole ΔT_a steps
 
 
 @pytest.mark.parametrize("name", ["greedy", "greedy_exact", "ga", "soa", "soa_exact"])
-def test_every_heuristic_passes_model_and_verifier(paper_problem, paper_results, tmp_path, name):
+def test_every_heuristic_passes_model_and_verifier(calibrated_problem, paper_results, name):
     schedule = paper_results[name]
     assert schedule.status == "feasible" and schedule.bound is None and schedule.gap is None
-    assert violations(paper_problem, schedule.operated, schedule.delay_s) == []
-    assert schedule.objective == pytest.approx(evaluate(paper_problem, schedule.operated, schedule.delay_s))
-    write_schedule(tmp_path / name, paper_problem, schedule)
-    assert verify_dir(tmp_path / name) == []
+    assert violations(calibrated_problem, schedule.operated, schedule.delay_s) == []
+    assert_verified(calibrated_problem, schedule)
+    # no heuristic can beat a valid lower bound of the optimum (uamopt/solvers/rolling.py)
+    assert schedule.objective >= pair_matching_bound(calibrated_problem) - OBJ_TOL
 
 
 @pytest.mark.parametrize("solver", ["ga", "soa"])
-def test_genetic_at_least_as_good_as_its_greedy_seed(paper_results, solver):
-    greedy, result = paper_results["greedy"], paper_results[solver]
-    assert result.extras["greedy_objective"] == pytest.approx(greedy.objective)
-    assert result.objective <= greedy.objective
-    history = result.extras["history"]
-    assert len(history) == SHORT["generations"] + 1 and all(np.diff(history) <= 0)
-
-
-@pytest.mark.parametrize("solver", ["ga", "soa"])
-def test_same_seed_same_result(paper_problem, paper_results, solver):
-    again = solve(paper_problem, SolverProfile(solver, seed=3, options=SHORT))
+def test_same_seed_same_result(calibrated_problem, paper_results, solver):
+    again = solve(calibrated_problem, SolverProfile(solver, seed=3, options=SHORT))
     first = paper_results[solver]
     assert np.array_equal(again.operated, first.operated) and np.array_equal(again.delay_s, first.delay_s)
-    other = solve(paper_problem, SolverProfile(solver, seed=4, options=SHORT))
+    other = solve(calibrated_problem, SolverProfile(solver, seed=4, options=SHORT))
     assert other.extras["history"] != first.extras["history"]
 
 
 @pytest.mark.parametrize("solver", ["ga", "soa"])
-def test_time_limit_is_honoured(paper_problem, solver):
-    result = solve(paper_problem, SolverProfile(solver, time_limit_s=0.2, options={"generations": 1_000_000}))
+def test_time_limit_is_honoured(calibrated_problem, solver):
+    result = solve(calibrated_problem, SolverProfile(solver, time_limit_s=0.2, options={"generations": 1_000_000}))
     assert result.status == "time_limit" and result.solve_seconds < 1.5
     assert 0 < result.extras["generations"] < 1_000_000
-    assert violations(paper_problem, result.operated, result.delay_s) == []
+    assert violations(calibrated_problem, result.operated, result.delay_s) == []
 
 
-def test_soa_stops_when_cold(paper_problem):
+def test_soa_stops_when_cold(calibrated_problem):
     # T = T_0 ξ^l: 1, 0.5, 0.25, 0.125, then 0.0625 < T_F = 0.1 -> four generations
-    result = solve(paper_problem, SolverProfile("soa", options={"t0": 1.0, "xi": 0.5, "t_final": 0.1}))
+    result = solve(calibrated_problem, SolverProfile("soa", options={"t0": 1.0, "xi": 0.5, "t_final": 0.1}))
     assert result.status == "feasible" and result.extras["generations"] == 4
 
 
 @settings(max_examples=15, deadline=None)
 @given(seed=st.integers(0, 2**32 - 1), cancel=st.floats(0.0, 0.3), dense=st.floats(0.0, 1.0))
-def test_any_chromosome_decodes_feasibly(paper_problem, seed, cancel, dense):
+def test_any_chromosome_decodes_feasibly(calibrated_problem, seed, cancel, dense):
     rng = np.random.default_rng(seed)
-    n = paper_problem.n_flights
-    top = np.floor(paper_problem.delay_upper_s / 10.0).astype(np.int64)
+    n = calibrated_problem.n_flights
+    top = np.floor(calibrated_problem.delay_upper_s / 10.0).astype(np.int64)
     genes = np.where(rng.random((8, n)) < dense, rng.integers(0, top + 1, size=(8, n)), 0)
     genes = np.where(rng.random((8, n)) < cancel, CANCEL, genes)
-    operated, delay = decoder_for(paper_problem).decode(paper_problem, genes)
-    w = objective_values(paper_problem, operated, delay)
+    operated, delay = decoder_for(calibrated_problem).decode(calibrated_problem, genes)
+    w = objective_values(calibrated_problem, operated, delay)
     for i in range(len(genes)):
-        assert violations(paper_problem, operated[i], delay[i]) == []
-        assert w[i] == pytest.approx(evaluate(paper_problem, operated[i], delay[i]))
+        assert violations(calibrated_problem, operated[i], delay[i]) == []
+        assert w[i] == pytest.approx(objective(operated[i], delay[i], calibrated_problem.weights,
+                                               calibrated_problem.aircraft_count))
         assert not operated[i][genes[i] == CANCEL].any()
 
 
-def test_a_feasible_schedule_decodes_from_its_own_delays(paper_results, paper_problem):
+def test_a_feasible_schedule_decodes_from_its_own_delays(paper_results, calibrated_problem):
     """Every feasible schedule on the ΔT_a grid is reachable: its delays, as genes, decode to itself."""
     best = paper_results["soa"]
     genes = np.where(best.operated, np.round(best.delay_s / 10.0), CANCEL).astype(np.int64)
-    operated, delay = decoder_for(paper_problem).decode(paper_problem, genes)
+    operated, delay = decoder_for(calibrated_problem).decode(calibrated_problem, genes)
     assert np.array_equal(operated[0], best.operated) and np.array_equal(delay[0], best.delay_s)
 
 
@@ -193,14 +192,13 @@ def test_fitness_eq36():
     ("soa", {"xi": 1.5}, "option xi = 1.5 out of range"),
     ("ga", {"population": 2.5}, "option population must be int"),
 ])
-def test_bad_options_are_one_line_errors(paper_problem, solver, options, match):
+def test_bad_options_are_one_line_errors(calibrated_problem, solver, options, match):
     with pytest.raises(UamoptError, match=match):
-        solve(paper_problem, SolverProfile(solver, options=options))
+        solve(calibrated_problem, SolverProfile(solver, options=options))
 
 
-def test_paper_case_plan_scales_only_the_delay_threshold():
-    scenario = load_scenario(PAPER_CASE)
-    network = straight_network(scenario, AirspaceGrid.from_extent(scenario.grid.cell, scenario.grid.extent))
+def test_paper_case_plan_scales_only_the_delay_threshold(paper_straight_plan):
+    scenario, _, network, _ = paper_straight_plan
     full, tight = paper_case_plan(scenario, network, max_delay_scale=1.0), paper_case_plan(scenario, network)
     np.testing.assert_array_equal(full.planned_departure_s, tight.planned_departure_s)
     np.testing.assert_array_equal(tight.max_delay_s, np.floor(0.3 * full.max_delay_s + 0.5))  # Eq. 29, ≤

@@ -23,7 +23,7 @@ from uamopt.planning.movingai import (
 )
 
 # The public benchmark files (N. Sturtevant's Moving AI grids; credits in tests/data/movingai/README.md)
-# ship with the tests; the shared/ folder beside the repository holds the same files.
+# ship with the tests.
 BENCHMARKS = Path(__file__).resolve().parent / "data" / "movingai"
 MAPS = ("arena.map", "maze512-32-9.map")
 SAMPLE_SIZE = 40
@@ -54,14 +54,14 @@ def test_map_is_read_with_rows_as_y():
     np.testing.assert_array_equal(octile.passable, [[True, True], [False, True], [False, False]])
 
 
-@pytest.mark.parametrize("text", [
-    "type octile\nheight 2\nwidth 3\nmap\n...\n..\n",  # short row
-    "type octile\nheight 3\nwidth 3\nmap\n...\n...\n",  # missing row
-    "type hex\nheight 1\nwidth 1\nmap\n.\n",
-    "type octile\nwidth 1\nmap\n.\n",
+@pytest.mark.parametrize("text, match", [
+    ("type octile\nheight 2\nwidth 3\nmap\n...\n..\n", "does not have 2 rows of 3 characters"),  # short row
+    ("type octile\nheight 3\nwidth 3\nmap\n...\n...\n", "does not have 3 rows of 3 characters"),  # missing row
+    ("type hex\nheight 1\nwidth 1\nmap\n.\n", "has type 'hex'"),
+    ("type octile\nwidth 1\nmap\n.\n", "lacks an integer height or width"),
 ])
-def test_malformed_map_raises(text):
-    with pytest.raises(InputFileError):
+def test_malformed_map_raises(text, match):
+    with pytest.raises(InputFileError, match=match):
         read_map_text(text)
 
 

@@ -5,29 +5,24 @@ whose points do not dominate one another and whose ends are the single-objective
 from __future__ import annotations
 
 import dataclasses
-from pathlib import Path
 
 import numpy as np
 import pytest
 from matplotlib import colors, image
 
-from uamopt import build_grid, load_city, load_scenario, risk_field
 from uamopt.planning import SearchProblem, grid_search, plan_track, planning_model
 from uamopt.planning.pareto import ParetoPoint, non_dominated, pareto_front, plot_pareto, weight_sweep
 from uamopt.planning.tracks import endpoint_cell, track_metrics
 from uamopt.plot_tracks import STAGE_STYLE, along_track_m, pair_directions, plot_network, plot_tracks
 from uamopt.plots import DPI, FIGSIZE_IN, OSM_CREDIT
 
-ROOT = Path(__file__).resolve().parents[1]
 PIXELS = (round(FIGSIZE_IN[1] * DPI), round(FIGSIZE_IN[0] * DPI))  # (rows, columns)
 ORIGIN, DESTINATION = (300.0, 300.0, 120.0), (2220.0, 4220.0, 120.0)  # V1 → V4
 
 
 @pytest.fixture(scope="module")
-def coarse():
-    scenario = load_scenario(ROOT / "models" / "paper_case.toml").with_overrides(["grid.cell=[100,100,60]"])
-    grid = build_grid(scenario)
-    model = planning_model(scenario, risk_field(scenario, grid, load_city(scenario, grid)))
+def coarse(coarse_run):
+    model = planning_model(coarse_run.scenario, coarse_run.field)
     return model, plan_track(model, ORIGIN, DESTINATION)
 
 

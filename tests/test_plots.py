@@ -3,13 +3,11 @@
 from __future__ import annotations
 
 import dataclasses
-from pathlib import Path
 
 import numpy as np
 import pytest
 from matplotlib import image
 
-from uamopt import build_grid, load_city, load_scenario, risk_field
 from uamopt.plots import (
     DPI,
     FIGSIZE_IN,
@@ -20,15 +18,12 @@ from uamopt.plots import (
     plot_risk,
 )
 
-ROOT = Path(__file__).resolve().parents[1]
 PIXELS = (round(FIGSIZE_IN[1] * DPI), round(FIGSIZE_IN[0] * DPI))  # (rows, columns) = (1040, 1820)
 
 
 @pytest.fixture(scope="module")
-def paper():
-    scenario = load_scenario(ROOT / "models" / "paper_case.toml")
-    grid = build_grid(scenario)
-    return scenario, risk_field(scenario, grid, load_city(scenario, grid))
+def paper(paper_run):
+    return paper_run.scenario, paper_run.field
 
 
 def _credited(field, text: str, source: str | None = None):

@@ -87,7 +87,7 @@ def test_obstacles_and_binary_field(npz):
 
 
 def test_roads_dominate_with_table_b3_values(npz):
-    """Any free cell above a road exceeds R_0; no free cell above open ground does (MODEL_NOTES)."""
+    """Any free cell above a road exceeds R_0; no free cell above open ground does (docs/readings.md)."""
     free = ~npz["obstacle"]
     road = np.broadcast_to(npz["road_length"][:, :, None] > 0.41, free.shape)
     no_road = np.broadcast_to(npz["road_length"][:, :, None] == 0, free.shape)

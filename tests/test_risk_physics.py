@@ -1,4 +1,4 @@
-"""The risk model's physics against MODEL_NOTES reference numbers and known limits."""
+"""The risk model's physics against the reference numbers of docs/readings.md and known limits."""
 
 from __future__ import annotations
 
@@ -8,6 +8,8 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp, tplquad
 
+from uamopt.city.layers import CityLayers
+from uamopt.grid import AirspaceGrid
 from uamopt.risk import (
     crash_area,
     drag_constant,
@@ -16,6 +18,7 @@ from uamopt.risk import (
     impact_energy,
     impact_speed,
     mean_relative_speed,
+    risk_field,
     swept_volume,
     terminal_speed,
     vehicle_collision_probability,
@@ -43,7 +46,7 @@ def k_for(payload_kg: float) -> float:
     return drag_constant(400.0 + payload_kg, 0.3, 1.225, S_E)
 
 
-# (terminal, v(148.2), t(148.2), E, P cs=0.5, P cs=0.75, R^P cs=0.5) from MODEL_NOTES
+# (terminal, v(148.2), t(148.2), E, P cs=0.5, P cs=0.75, R^P cs=0.5) from docs/readings.md (Reference numbers)
 REFERENCE = {
     0.0: ("27.468", "27.174496", "7.323078", "147690.7", "0.277616", "0.115849", "1.185261e-07"),
     220.0: ("34.198", "32.740228", "6.677222", "332296.0", "0.365664", "0.146535", "1.561174e-07"),
@@ -75,11 +78,17 @@ def test_reference_numbers(payload):
 
 
 def test_vehicle_terms():
-    p_v = vehicle_collision_probability(9.68, 0.07, 3.5)
-    assert p_v == approx_printed("0.1936")
-    n_v = 0.07 * 50.0
-    assert n_v == approx_printed("3.5")
-    assert LAM * n_v * p_v == approx_printed("4.092704e-05")
+    """P^V (Eq. 5) and R^V = λ N^V P^V (Eq. 4) of a column with l_r = 50 m of road, through the
+    field computation: N^V = ρ_V l_r = 3.5 makes R^V = 4.092704e-05 at every altitude (reference)."""
+    assert vehicle_collision_probability(9.68, 0.07, 3.5) == approx_printed("0.1936")
+    grid = AirspaceGrid(cell=(50.0, 50.0, 30.0), shape=(2, 1, 10))
+    zeros = np.zeros((2, 1))
+    city = CityLayers(zeros, zeros, np.array([[0.0], [50.0]]), zeros + 2.5e-4, zeros + 0.5, zeros > 0, zeros > 0,
+                      source="test")
+    field = risk_field(B3, grid, city)
+    assert np.all(field.risk_V[0] == 0.0)
+    for value in field.risk_V[1, 0]:
+        assert value == approx_printed("4.092704e-05")
 
 
 @pytest.mark.parametrize("payload", [0.0, 220.0])
@@ -162,7 +171,7 @@ def test_road_threshold_and_open_ground_bound():
     e_max = float(impact_energy(620.0, terminal_speed(k, G)))
     p_max = float(fatality_probability(e_max, 0.5, 1e6, 232.0))
     people = 0.5 * LAM * 2.5e-4 * S_E * p_max
-    assert people == pytest.approx(8.02e-8, rel=5e-4)  # the bound MODEL_NOTES quotes, to its 3 digits
+    assert people == pytest.approx(8.02e-8, rel=5e-4)  # the bound docs/readings.md quotes, to its 3 digits
     t_300 = float(fall_time(300.0, k, G))
     uav = 0.2 * LAM * 3.48e-8 * 5.63 * 1.855 * (23.664 * t_300 + 5.63)
     assert people + uav < 1e-7

@@ -1,69 +1,92 @@
-"""The rolling-horizon solver (uamopt/solvers/rolling.py) on the paper case: a feasible schedule,
-a valid lower bound, never better than the exact optimum, reproducible.
-
-``rolling`` may not be in ``SOLVERS`` yet, so the module is called directly with a profile that
-names a registered solver (the profile's ``solver`` field is not read by ``rolling.solve``).
+"""The rolling-horizon solver (uamopt/solvers/rolling.py): a feasible schedule (verifier, objective
+recomputed from the files), a valid lower bound (never above the proven optimum), never better
+than the exact optimum, reproducible; through the registry (``solve(p, "rolling")``) and directly.
 """
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
-from conftest import PAPER_CASE
+from checks import OBJ_TOL, assert_verified
+from hypothesis import HealthCheck, given, settings
+from strategies import tiny_problems
 
-from uamopt.grid import AirspaceGrid
-from uamopt.scenario import load_scenario
-from uamopt.schedule import (
-    build_problem,
-    evaluate,
-    generate_plan,
-    straight_network,
-    violations,
-)
-from uamopt.solvers import SolverProfile, milp, rolling
-
-OBJ_TOL = 1e-6
-
-
-@pytest.fixture(scope="module")
-def paper_problem():
-    scenario = load_scenario(PAPER_CASE)
-    grid = AirspaceGrid.from_extent(scenario.grid.cell, scenario.grid.extent)
-    return build_problem(generate_plan(scenario, straight_network(scenario, grid), 0), scenario)
+from uamopt.errors import UamoptError
+from uamopt.schedule import Flight, FlightSet, build_problem, generate_plan, violations
+from uamopt.solvers import SolverProfile, bruteforce, milp, rolling, solve
+from uamopt.solvers.rolling import pair_matching_bound
 
 
 def profile(**options) -> SolverProfile:
-    return SolverProfile("cpsat", time_limit_s=20.0, threads=1, seed=0, options={"window_s": 900.0, **options})
+    return SolverProfile("rolling", time_limit_s=20.0, threads=1, seed=0, options={"window_s": 900.0, **options})
 
 
-def test_rolling_paper_case(paper_problem):
+@pytest.fixture(scope="module")
+def paper_optimum(paper_highs):
+    assert paper_highs.status == "optimal"
+    return paper_highs.objective
+
+
+def test_rolling_paper_case(paper_problem, paper_optimum):
     problem = paper_problem
     first = rolling.solve(problem, profile())
-    exact = milp.solve(problem, SolverProfile("highs", time_limit_s=30.0, threads=2))
-    assert exact.status == "optimal"
     assert first.status in ("feasible", "time_limit") and first.solver == "rolling"
     assert violations(problem, first.operated, first.delay_s) == []
-    assert first.objective == pytest.approx(evaluate(problem, first.operated, first.delay_s), abs=1e-12)
-    assert first.bound is not None and first.bound <= exact.objective + OBJ_TOL <= first.objective + 2 * OBJ_TOL
+    assert_verified(problem, first)
+    assert first.bound <= paper_optimum + OBJ_TOL <= first.objective + 2 * OBJ_TOL
     assert first.extras["windows"] > 1
     again = rolling.solve(problem, profile())
     assert np.array_equal(again.operated, first.operated) and np.array_equal(again.delay_s, first.delay_s)
     assert again.objective == first.objective
 
 
-def test_rolling_highs_inner_and_bound(paper_problem):
-    problem = paper_problem
-    s = rolling.solve(problem, profile(inner="highs", window_s=1200.0))
-    assert violations(problem, s.operated, s.delay_s) == []
-    assert s.bound <= s.objective
-    # the bound is at least the trivial one (every flight operated on time)
-    assert s.bound >= -problem.weights[1] * problem.n_flights
+def test_rolling_highs_inner_and_bound(paper_problem, paper_optimum):
+    s = rolling.solve(paper_problem, profile(inner="highs", window_s=1200.0))
+    assert_verified(paper_problem, s)
+    assert s.bound <= paper_optimum + OBJ_TOL <= s.objective + 2 * OBJ_TOL
 
 
-def test_rolling_rejects_unknown_option(paper_problem):
-    from uamopt.errors import UamoptError
+def test_solve_by_name_uses_the_shipped_profile(paper_straight_plan):
+    """``solve(problem, "rolling")`` reads solvers/rolling.toml (900 s windows, CP-SAT inside). On 6
+    aircraft (36 flights) its windows cost it against the whole-day optimum, and its bound is valid."""
+    scenario, _, network, _ = paper_straight_plan
+    problem = build_problem(generate_plan(scenario, network, seed=0, aircraft=6, max_delay_scale=1.0), scenario)
+    s = solve(problem, "rolling")
+    exact = milp.solve(problem, SolverProfile("highs", time_limit_s=30.0, threads=2))
+    assert s.solver == "rolling" and s.extras["windows"] == 4 and exact.status == "optimal"
+    assert_verified(problem, s)
+    assert s.bound <= exact.objective + OBJ_TOL <= s.objective + 2 * OBJ_TOL
 
-    with pytest.raises(UamoptError):
-        rolling.solve(paper_problem, profile(bogus=1))
-    with pytest.raises(UamoptError):
-        rolling.solve(paper_problem, profile(inner="ga"))
+
+def test_pair_matching_bound_by_hand():
+    """Two aircraft on one track at the same time, 50 m cells, r = 1, 25 m/s: δ must leave (−4, 4) s.
+    Each pair member alone gives −ω7; together −2ω7 + ω6/G·4 (G = 2). (ω6, ω7) = (0.6, 0.4):
+    min(−0.4, −0.8 + 1.2) = −0.4, which is the optimum (cancel one: −0.4; delay one 4 s: +0.4),
+    above the trivial −ω7·n = −0.8."""
+    track = np.array([[25.0, 25.0, 45.0], [525.0, 25.0, 45.0]])
+    flights = tuple(Flight(id=f"{a}1", aircraft=a, route="E", origin="a", destination="b", speed_mps=25.0,
+                           planned_departure_s=0.0, max_delay_s=100.0, waypoints=track) for a in "AB")
+    problem = build_problem(FlightSet(cell=(50.0, 50.0, 30.0), conflict_radius=1, flights=flights))
+    assert pair_matching_bound(problem) == pytest.approx(-0.4, abs=1e-5)  # dist reduced by 2e-6 s (tolerance)
+    assert bruteforce.solve(problem).objective == pytest.approx(-0.4)
+
+
+@settings(max_examples=25, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
+@given(tiny_problems())
+def test_tiny_instances_rolling_against_bruteforce(case):
+    """Short windows (5 s) on tiny instances: never better than the optimum, bound never above it."""
+    _, problem = case
+    optimum = bruteforce.solve(problem).objective
+    s = rolling.solve(problem, SolverProfile("rolling", time_limit_s=10.0, threads=1, options={"window_s": 5.0}))
+    assert_verified(problem, s)
+    assert s.objective >= optimum - OBJ_TOL and s.bound <= optimum + OBJ_TOL
+
+
+@pytest.mark.parametrize("options, match", [
+    ({"bogus": 1}, "unknown option 'bogus'"),
+    ({"inner": "ga"}, "unknown inner solver 'ga'"),
+    ({"window_s": 0.0}, "window_s must be positive"),
+])
+def test_rolling_rejects_bad_options(paper_problem, options, match):
+    with pytest.raises(UamoptError, match=match):
+        rolling.solve(paper_problem, profile(**options))

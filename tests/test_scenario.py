@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 
 import pytest
 
@@ -26,7 +27,7 @@ def test_defaults_are_table_b3():
     assert s.schedule.weights == (0.6, 0.4)
     ports = {v.name: (v.x, v.y) for v in s.network.vertiports}
     assert ports == {"V1": (300, 300), "V2": (300, 4220), "V3": (2220, 300), "V4": (2220, 4220), "V5": (1260, 2260)}
-    # L_14 = 4365 m is |V4 - V1| (MODEL_NOTES)
+    # L_14 = 4365 m is |V4 - V1| (docs/readings.md)
     assert math.dist(ports["V1"], ports["V4"]) == pytest.approx(4365, abs=0.5)
 
 
@@ -73,7 +74,7 @@ def _write(tmp_path, text):
     ("[network]\nroutes = [['V1', 'V9']]", [], "network.routes"),
 ])
 def test_bad_scenarios_give_one_line(tmp_path, text, overrides, fragment):
-    with pytest.raises(ScenarioError) as info:
+    with pytest.raises(ScenarioError, match=re.escape(fragment)) as info:
         load_scenario(_write(tmp_path, text), overrides)
     line = info.value.line()
     assert fragment in line and "\n" not in line
@@ -86,6 +87,6 @@ def test_missing_file(tmp_path):
 
 
 def test_unknown_key_lists_valid_keys(tmp_path):
-    with pytest.raises(ScenarioError) as info:
+    with pytest.raises(ScenarioError, match="unknown key 'risk.lambda'") as info:
         load_scenario(_write(tmp_path, "[risk]\nlambda = 1"))
     assert "failure_rate_per_h" in info.value.fix

@@ -21,7 +21,7 @@ import numpy as np
 import pytest
 from conftest import PAPER_CASE
 from hypothesis import HealthCheck, given, settings
-from test_exact_solvers import tiny_problems
+from strategies import tiny_problems
 
 from uamopt.schedule import (
     build_problem,

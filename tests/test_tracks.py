@@ -12,7 +12,7 @@ from scipy.spatial import cKDTree
 from uamopt.errors import UamoptError
 from uamopt.geometry import polyline_pieces
 from uamopt.planning import plan_track, planning_model
-from uamopt.planning.network import load_network, network_document, plan_network
+from uamopt.planning.network import load_network, plan_network
 from uamopt.planning.problem import SHORTEST_TIE_BREAK, buffer_cells, buffer_shell_count, box_counts, load_factor, transport_rates
 from uamopt.planning.tracks import corner_fillets, exact_equivalent_track, midpoint_track
 from uamopt.scenario import Scenario, load_scenario
@@ -22,9 +22,8 @@ P_O, P_D = (300.0, 300.0, 120.0), (2220.0, 4220.0, 120.0)
 
 
 @pytest.fixture(scope="module")
-def model(root):
-    s = load_scenario(root / "models" / "paper_case.toml")
-    return planning_model(s, compute_risk(s).field)
+def model(paper_model):
+    return paper_model
 
 
 @pytest.fixture(scope="module")
@@ -33,7 +32,7 @@ def plan(model):
 
 
 def test_transport_cost_of_the_straight_segment_matches_table2():
-    """MODEL_NOTES: m_p ≈ 145.6 kg makes the straight 4365 m level track cost ¥27.15 (±0.5 %)."""
+    """docs/readings.md: m_p ≈ 145.6 kg makes the straight 4365 m level track cost ¥27.15 (±0.5 %)."""
     c_h, _ = transport_rates(Scenario())
     assert load_factor(Scenario()) == pytest.approx(1 + 145.6 / 220 * 1.56)
     assert c_h * 4365.0 == pytest.approx(27.1527, rel=5e-3)
@@ -168,17 +167,24 @@ def test_aircraft_limits(root):
 def test_network_directions_on_separate_layers(model, tmp_path):
     network = plan_network(model)
     assert len(network) == 20
-    layers = {name: k for name, (_, _, _, k) in network.items()}
-    assert layers["V1-V4"] != layers["V4-V1"]
-    for name, (o, d, p, k) in network.items():
-        cells, _, _ = polyline_pieces(p.stages["optimal"].waypoints, model.field.grid.cell)
-        assert np.all(cells[:, 2] == k), name
-    doc = network_document(model, network)
+    assert network["V1-V4"].layer_k != network["V4-V1"].layer_k
+    for name, route in network.routes.items():
+        cells, _, _ = polyline_pieces(route.waypoints, model.field.grid.cell)
+        assert np.all(cells[:, 2] == route.layer_k), name
+        np.testing.assert_array_equal(route.waypoints, route.plan.stages["optimal"].waypoints)
     import json
     path = tmp_path / "network.json"
-    path.write_text(json.dumps(doc))
+    path.write_text(json.dumps(network.to_document()))
     loaded = load_network(path)
-    assert set(loaded) == set(network) and loaded["V1-V4"].shape[1] == 3
+    assert set(loaded.routes) == set(network.routes)
+    for name, route in network.routes.items():
+        back = loaded[name]
+        np.testing.assert_array_equal(back.waypoints, route.waypoints)
+        assert (back.origin, back.destination, back.layer_k, back.length_m, back.transport_cost) == \
+            (route.origin, route.destination, route.layer_k, route.length_m, route.transport_cost)
+    frame = network.to_frame()
+    assert len(frame) == 20 and frame.loc["V1-V4", "origin"] == "V1"
+    assert frame.loc["V1-V4", "length_m"] >= 4365.0  # no track is shorter than the straight line
 
 
 def test_share_variant_gives_table2_shape(root):

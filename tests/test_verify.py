@@ -104,9 +104,9 @@ def test_verifier_finds_what_the_model_forbids(paper_problem, tmp_path):
     """Operate everything as planned: each model conflict is a verifier conflict, and vice versa."""
     n = paper_problem.n_flights
     on, delay = np.ones(n, bool), np.zeros(n)
+    dep, tol = paper_problem.planned_departure_s, 1e-6  # the verifier's tolerance: touching intervals are no conflict
     model = {(c.p, c.q) for c in paper_problem.conflicts
-             if np.any((c.intervals[:, 0] < paper_problem.planned_departure_s[c.q] - paper_problem.planned_departure_s[c.p])
-                       & (paper_problem.planned_departure_s[c.q] - paper_problem.planned_departure_s[c.p] < c.intervals[:, 1]))}
+             if np.any((c.intervals[:, 0] + tol < dep[c.q] - dep[c.p]) & (dep[c.q] - dep[c.p] < c.intervals[:, 1] - tol))}
     ids = [f.id for f in paper_problem.flights.flights]
     pattern = re.compile(r"conflict: flights (\S+) \(.*\) in cell .* and (\S+) \(")
     found = {tuple(sorted(ids.index(x) for x in pattern.match(v).groups()))

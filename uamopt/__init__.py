@@ -1,14 +1,27 @@
 """uamopt: Urban Air Mobility operations research toolkit.
 
-Data flows one way (STYLE.md): scenario → city layers → airspace grid → risk field → graph →
-tracks → flight plan → schedule. Each stage is importable on its own from a notebook::
+Data flows one way: scenario → city layers → airspace grid → risk field → planning model →
+tracks → route network → flight plan → scheduling problem → solver → schedule → verification.
+Every stage is one call from ``import uamopt`` (see ``docs/interfaces.md``)::
 
-    from uamopt import load_scenario, build_grid, load_city, risk_field
-    scenario = load_scenario("models/paper_case.toml")
-    grid = build_grid(scenario)
-    city = load_city(scenario, grid)
-    field = risk_field(scenario, grid, city)
+    import uamopt as ua
+    scenario = ua.load_scenario("models/paper_case.toml", ["grid.cell=[25,25,30]"])
+    field = ua.compute_risk(scenario)
+    model = ua.planning_model(scenario, field)
+    plan = ua.plan_track(model, "V1", "V4")
+    network = ua.plan_network(model)
+    flights = ua.generate_flights(scenario, network)
+    problem = ua.build_problem(flights, scenario)
+    schedule = ua.solve(problem, "highs", time_limit_s=30)
+    assert ua.verify(problem, schedule).ok
+
+Names are resolved on first use, so ``import uamopt`` stays light (no solver, plotting or GIS
+library is imported until a stage needs it).
 """
+
+from __future__ import annotations
+
+import importlib
 
 from uamopt.errors import (
     GridError,
@@ -18,25 +31,41 @@ from uamopt.errors import (
     ScenarioError,
     UamoptError,
 )
-from uamopt.scenario import Scenario, load_scenario
-from uamopt.grid import AirspaceGrid, build_grid
-from uamopt.city import CityLayers, load_city
-from uamopt.risk import RiskField, risk_field
 
-__all__ = [
-    "AirspaceGrid",
-    "CityLayers",
-    "GridError",
-    "InfeasibleScheduleError",
-    "InputFileError",
-    "NoTrackError",
-    "RiskField",
-    "Scenario",
-    "ScenarioError",
-    "UamoptError",
-    "build_grid",
-    "load_city",
-    "load_scenario",
-    "risk_field",
-]
 __version__ = "0.1.0"
+
+#: public name -> module that defines it (imported on first access, PEP 562)
+_LAZY = {
+    "Scenario": "uamopt.scenario", "load_scenario": "uamopt.scenario",
+    "AirspaceGrid": "uamopt.grid", "build_grid": "uamopt.grid",
+    "CityLayers": "uamopt.city", "load_city": "uamopt.city",
+    "RiskField": "uamopt.risk", "risk_field": "uamopt.risk",
+    "compute_risk": "uamopt.pipeline", "planning_model": "uamopt.pipeline", "plan_track": "uamopt.pipeline",
+    "plan_network": "uamopt.pipeline", "generate_flights": "uamopt.pipeline", "build_problem": "uamopt.pipeline",
+    "solve": "uamopt.pipeline", "solver_profile": "uamopt.pipeline", "verify": "uamopt.pipeline",
+    "Verification": "uamopt.pipeline",
+    "PlanningModel": "uamopt.planning.problem", "TrackPlan": "uamopt.planning.tracks",
+    "RouteNetwork": "uamopt.planning.network",
+    "FlightSet": "uamopt.schedule.flights", "SchedulingProblem": "uamopt.schedule.model",
+    "Schedule": "uamopt.schedule.model", "SolverProfile": "uamopt.solvers",
+    "load_risk": "uamopt.io", "load_tracks": "uamopt.io", "load_network": "uamopt.io",
+    "load_flights": "uamopt.io", "load_schedule": "uamopt.io",
+}
+
+__all__ = sorted([*_LAZY, "GridError", "InfeasibleScheduleError", "InputFileError", "NoTrackError",
+                  "ScenarioError", "UamoptError"])
+
+
+def __getattr__(name: str):
+    if name in _LAZY:
+        value = getattr(importlib.import_module(_LAZY[name]), name)
+        globals()[name] = value
+        return value
+    if name in ("plotting", "benchmark", "sweep"):  # a package, or a module's function of that name
+        module = importlib.import_module(f"uamopt.{name}")
+        return getattr(module, name, module)
+    raise AttributeError(f"module 'uamopt' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted([*globals(), *_LAZY])

@@ -1,4 +1,4 @@
-"""Command line: ``uamopt COMMAND SCENARIO [--set KEY=VALUE ...] [--out DIR]`` (INTERFACES.md).
+"""Command line: ``uamopt COMMAND SCENARIO [--set KEY=VALUE ...] [--out DIR]`` (docs/interfaces.md).
 
 Bad input ends with one line ``error: <what> (<where>): <how to fix>`` on stderr and exit code 2;
 results are staged and moved into ``--out`` only when complete.
@@ -7,16 +7,15 @@ results are staged and moved into ``--out`` only when complete.
 from __future__ import annotations
 
 import argparse
-import math
 import sys
 import time
 from pathlib import Path
 
-import numpy as np
 
 from uamopt.errors import UamoptError
 
 EXIT_BAD_INPUT = 2
+_STARTED = time.perf_counter()  # the command's own clock (imports included)
 
 
 class _Parser(argparse.ArgumentParser):
@@ -61,17 +60,16 @@ def _risk_stage(scenario, stage: Path, bar) -> dict:
     return run, summary
 
 
-def _point(text: str | None, option: str, default) -> tuple[float, float, float]:
-    """Parse ``X,Y,Z`` (metres) of --from/--to; the scenario's P_O/P_D when omitted."""
-    if text is None:
-        return tuple(float(v) for v in default)  # type: ignore[return-value]
-    try:
-        values = tuple(float(v) for v in text.split(","))
-    except ValueError:
-        values = ()
-    if len(values) != 3 or not all(map(math.isfinite, values)):
-        raise UamoptError(f"{option} {text!r} is not a point", option, "write X,Y,Z in metres, e.g. 300,300,120")
-    return values  # type: ignore[return-value]
+def _endpoints(scenario, args):
+    """--from/--to (X,Y,Z or a vertiport name), else the scenario's route (tracks.route)."""
+    from uamopt.planning.endpoints import default_endpoints, parse_endpoint
+
+    origin, destination = default_endpoints(scenario) if (args.origin is None or args.destination is None) else (None, None)
+    if args.origin is not None:
+        origin = parse_endpoint(scenario, args.origin, "--from")
+    if args.destination is not None:
+        destination = parse_endpoint(scenario, args.destination, "--to")
+    return origin, destination
 
 
 def _planning(scenario, bar):
@@ -104,27 +102,24 @@ def _plan_stage(scenario, model, origin, destination, stage: Path, bar) -> dict:
     return doc
 
 
-def _network_stage(scenario, model, stage: Path, bar) -> dict:
+def _network_stage(scenario, model, stage: Path, bar):
     """Plan every route in both directions and write network.json and network.png."""
     from uamopt.outputs import write_json
-    from uamopt.planning.network import network_document, plan_network
+    from uamopt.planning.network import plan_network
     from uamopt.plot_tracks import plot_network
 
     bar.set_description("network")
     network = plan_network(model, progress=bar)
-    doc = network_document(model, network)
-    write_json(stage / "network.json", doc)
-    plot_network(model, {k: np.asarray(v["waypoints"]) for k, v in doc["routes"].items()}, stage / "network.png",
-                 vertiports=scenario.network.vertiports)
-    return {"doc": doc, "plans": network}
+    write_json(stage / "network.json", network.to_document())
+    plot_network(model, network.waypoints(), stage / "network.png", vertiports=scenario.network.vertiports)
+    return network
 
 
 def cmd_plan(args) -> int:
     from uamopt.outputs import check_out_dir, staged_output
 
     scenario = _load(args)
-    origin = _point(args.origin, "--from", scenario.tracks.origin)
-    destination = _point(args.destination, "--to", scenario.tracks.destination)
+    origin, destination = _endpoints(scenario, args)
     check_out_dir(args.out)
     with _progress(4, "plan") as bar, staged_output(args.out) as stage:
         _, model = _planning(scenario, bar)
@@ -142,8 +137,8 @@ def cmd_network(args) -> int:
     check_out_dir(args.out)
     with _progress(2 + 2 * 10, "network") as bar, staged_output(args.out) as stage:
         _, model = _planning(scenario, bar)
-        result = _network_stage(scenario, model, stage, bar)
-    print(f"network: {len(result['doc']['routes'])} tracks -> {Path(args.out) / 'network.json'}")
+        network = _network_stage(scenario, model, stage, bar)
+    print(f"network: {len(network)} tracks -> {Path(args.out) / 'network.json'}")
     return 0
 
 
@@ -156,7 +151,8 @@ def cmd_risk(args) -> int:
         _, summary = _risk_stage(scenario, stage, bar)
     print(
         f"risk field: {summary['cells']:,} cells, {100 * summary['unsafe_share']:.1f} % unsafe, "
-        f"{summary['seconds']['risk']:.2f} s -> {Path(args.out) / 'risk.npz'}"
+        f"{summary['seconds']['risk']:.2f} s (whole command {time.perf_counter() - _STARTED:.2f} s) -> "
+        f"{Path(args.out) / 'risk.npz'}"
     )
     return 0
 
@@ -164,27 +160,27 @@ def cmd_risk(args) -> int:
 def _plan_at(scenario, side: float, extent) -> tuple:
     """Risk field, planning model and the P_O → P_D plan at cubic cells of ``side`` metres."""
     from uamopt.planning import plan_track, planning_model
+    from uamopt.planning.endpoints import default_endpoints
     from uamopt.stages import compute_risk
 
     started = time.perf_counter()
     fine = scenario.with_overrides([f"grid.cell=[{side},{side},{side}]", f"grid.extent={_toml_list(extent)}"])
     model = planning_model(fine, compute_risk(fine).field)
-    plan = plan_track(model, fine.tracks.origin, fine.tracks.destination)
+    plan = plan_track(model, *default_endpoints(fine))
     return fine, model, plan, time.perf_counter() - started
 
 
 REPRODUCE_SOLVERS = ("greedy", "ga", "soa", "highs", "cpsat")
 
 
-def _reproduce_schedules(scenario, model, network_doc: dict, stage: Path, bar) -> list[str]:
+def _reproduce_schedules(scenario, model, network, stage: Path, bar, provenance: dict | None = None) -> list[str]:
     """Table 3 / Fig. 19: every solver profile on the paper-case plan over the planned network."""
     from uamopt.plot_schedule import plot_delay_comparison, plot_gantt
-    from uamopt.report import table3_section
+    from uamopt.report import is_paper_schedule, table3_section
     from uamopt.schedule import build_problem, write_schedule
     from uamopt.schedule.verify import verify_dir
     from uamopt.solvers import load_profile, solve
 
-    network = {k: np.asarray(v["waypoints"]) for k, v in network_doc["routes"].items()}
     flights = _initial_plan(scenario, network, scenario.schedule.plan_seed)
     sections = []
     for objective in (scenario.schedule.objective, "lexicographic" if scenario.schedule.objective == "weighted" else "weighted"):
@@ -194,20 +190,22 @@ def _reproduce_schedules(scenario, model, network_doc: dict, stage: Path, bar) -
             bar.set_description(f"schedule ({objective}): {name}")
             schedule = solve(problem, load_profile(name))
             folder = stage / "schedules" / objective / name
-            write_schedule(folder, problem, schedule)
+            write_schedule(folder, problem, schedule, extra=provenance)
             schedules[name], verified[name] = schedule, not verify_dir(folder)
             bar.update(1)
         suffix = "" if objective == scenario.schedule.objective else f"_{objective}"
         best = min((s for s in schedules.values() if s.objective is not None), key=lambda s: s.objective)
         plot_gantt(problem, best, stage / f"gantt{suffix}.png")
         plot_delay_comparison(problem, schedules, stage / f"delays{suffix}.png")
-        sections.append(table3_section(problem, schedules, verified, suffix=suffix))
+        sections.append(table3_section(problem, schedules, verified, suffix=suffix,
+                                       paper=is_paper_schedule(scenario, problem)))
     return sections
 
 
 def cmd_reproduce(args) -> int:
     from uamopt.outputs import check_out_dir, staged_output, write_json
     from uamopt.planning import planning_model
+    from uamopt.planning.endpoints import default_endpoints, is_paper_track
     from uamopt.plot_tracks import plot_tracks
     from uamopt.planning.pareto import plot_pareto, weight_sweep
     from uamopt.report import (network_section, pareto_section, risk_section, table2_section, table4_section,
@@ -227,45 +225,47 @@ def cmd_reproduce(args) -> int:
             plans[side] = _plan_at(scenario, side, run.grid.extent)
             bar.update(1)
         fine, fine_model, plan, _ = plans[t2]
+        origin, destination = default_endpoints(scenario)
+        paper = is_paper_track(origin, destination)
         tracks = {**plan.as_dict(), "scenario": {"name": scenario.name, "file": scenario.source,
                                                  "cell": list(fine_model.field.grid.cell)}}
         write_json(stage / "tracks.json", tracks)
         plot_tracks(fine_model, plan, stage / "tracks.png", title=f"{scenario.name}, {t2:g} m cells")
         table4 = [(side, plans[side][2], plans[side][3]) for side in scenario.tracks.table4_cells]
         bar.set_description("buffer variant")
-        other = "share" if scenario.tracks.buffer_measure == "count" else "count"
+        other = "count" if scenario.tracks.buffer_measure != "count" else "structures"
         variant = scenario.with_overrides([f"tracks.buffer_measure={other}"])
         v_scenario, v_model, v_plan, _ = _plan_at(variant, t2, run.grid.extent)
         v_tracks = {**v_plan.as_dict()}
         bar.set_description("pareto front")
-        fronts = {flag: weight_sweep(model, scenario.tracks.origin, scenario.tracks.destination, 9, buffer=flag)
-                  for flag in (False, True)}
-        plot_pareto(fronts[False], stage / "pareto.png", title=f"{scenario.name}: Eq. 10 trade-off (μ = 0)")
-        sched_sections = _reproduce_schedules(scenario, model, network["doc"], stage, bar)
-        sections = [risk_section(scenario, summary), table2_section(fine, fine_model, tracks),
-                    table2_section(v_scenario, v_model, v_tracks, figure=False,
+        fronts = {flag: weight_sweep(fine_model, origin, destination, 9, buffer=flag) for flag in (False, True)}
+        plot_pareto(fronts[True], stage / "pareto.png", title=f"{scenario.name}: Eq. 10 + μ·R(t) trade-off")
+        from uamopt.export.frame import schedule_provenance
+
+        sched_sections = _reproduce_schedules(scenario, model, network, stage, bar, schedule_provenance(scenario, args.set))
+        sections = [risk_section(scenario, summary), table2_section(fine, fine_model, tracks, paper=paper),
+                    table2_section(v_scenario, v_model, v_tracks, figure=False, paper=paper,
                                    title=f"Table 2 analogue with the variant tracks.buffer_measure = \"{other}\""),
-                    table4_section(scenario, table4), pareto_section(scenario, model, fronts),
-                    network_section(scenario, network["doc"])] + sched_sections
+                    table4_section(scenario, table4, paper=paper),
+                    pareto_section(fine, fine_model, fronts, (origin.label, destination.label)),
+                    network_section(scenario, network.to_document())] + sched_sections
         write_report(stage / "report.md", scenario, sections)
     print(f"report: {Path(args.out) / 'report.md'}")
     return 0
 
 
 def _initial_plan(scenario, network, seed: int):
-    """The generated initial flight plan with the scenario's [schedule] knobs."""
-    from uamopt.solvers.calibration import paper_case_plan
+    """The generated initial flight plan with the scenario's [schedule] keys."""
+    from uamopt.schedule import generate_plan
 
-    sc = scenario.schedule
-    return paper_case_plan(scenario, network, seed, max_delay_scale=sc.max_delay_scale,
-                           first_departure_window_s=sc.first_departure_window_s, departure_step_s=sc.departure_step_s)
+    return generate_plan(scenario, network, seed)
 
 
 def _scheduling_problem(scenario, args, bar):
     """The flight set (given, or generated on the planned or given network) and its model."""
     from uamopt.grid import build_grid
     from uamopt.planning import planning_model
-    from uamopt.planning.network import load_network, network_document, plan_network
+    from uamopt.planning.network import load_network, plan_network
     from uamopt.schedule import build_problem, load_flights
     from uamopt.stages import compute_risk
 
@@ -277,8 +277,7 @@ def _scheduling_problem(scenario, args, bar):
     else:
         bar.set_description("network")
         model = planning_model(scenario, compute_risk(scenario).field)
-        doc = network_document(model, plan_network(model))
-        network = {k: np.asarray(v["waypoints"]) for k, v in doc["routes"].items()}
+        network = plan_network(model)
     bar.update(1)
     if args.flights:
         flights = load_flights(args.flights, scenario, grid, network)
@@ -290,7 +289,36 @@ def _scheduling_problem(scenario, args, bar):
     return problem
 
 
+def cmd_flights(args) -> int:
+    """The scenario's generated flight plan as a self-contained flights.json (the instance generator)."""
+    from uamopt.outputs import check_out_dir, staged_output, write_json
+    from uamopt.pipeline import build_problem, compute_risk, generate_flights, plan_network, planning_model
+    from uamopt.schedule import save_flights
+
+    scenario = _load(args)
+    check_out_dir(args.out)
+    with _progress(3, "flights") as bar, staged_output(args.out) as stage:
+        bar.set_description("network")
+        model = planning_model(scenario, compute_risk(scenario))
+        network = plan_network(model)
+        bar.update(1)
+        flights = generate_flights(scenario, network, args.seed)
+        bar.update(1)
+        problem = build_problem(flights, scenario)
+        save_flights(stage / "flights.json", flights)
+        write_json(stage / "summary.json", {
+            "scenario": scenario.name, "flights": len(flights), "aircraft": flights.n_aircraft,
+            "vertiports": len(scenario.network.vertiports), "directed_routes": len(network),
+            "tracks": scenario.network.tracks, "conflicting_pairs": len(problem.conflicts),
+            "seed": scenario.schedule.plan_seed if args.seed is None else args.seed, "plan_notes": list(flights.notes)})
+        bar.update(1)
+    print(f"flights: {len(flights)} flights, {flights.n_aircraft} aircraft, {len(problem.conflicts)} conflicting pairs "
+          f"-> {Path(args.out) / 'flights.json'}")
+    return 0
+
+
 def cmd_schedule(args) -> int:
+    from uamopt.export.frame import schedule_provenance
     from uamopt.outputs import check_out_dir
     from uamopt.schedule import write_schedule
     from uamopt.schedule.verify import verify_dir
@@ -299,12 +327,13 @@ def cmd_schedule(args) -> int:
     scenario = _load(args)
     profile = load_profile(args.solver)
     check_out_dir(args.out)
+    provenance = schedule_provenance(scenario, args.set)  # frame and scenario for the exports
     with _progress(3, "schedule") as bar:
         problem = _scheduling_problem(scenario, args, bar)
         bar.set_description(profile.solver)
         schedule = solve(problem, profile)
         bar.update(1)
-    write_schedule(args.out, problem, schedule)
+    write_schedule(args.out, problem, schedule, extra=provenance)
     problems = verify_dir(args.out)
     print(f"{schedule.solver}: {schedule.status}, objective {schedule.objective}, operated {schedule.operated_count}, "
           f"cancelled {schedule.cancelled}, total delay {schedule.total_delay_s:.1f} s, "
@@ -391,9 +420,14 @@ def build_parser() -> argparse.ArgumentParser:
 
     command("risk", cmd_risk, "compute the operational risk field: risk.npz, risk.png, summary.json", "out/risk")
     plan = command("plan", cmd_plan, "plan one track in four stages: tracks.json, tracks.png", "out/plan")
-    plan.add_argument("--from", dest="origin", metavar="X,Y,Z", help="origin, m (default: tracks.origin, P_O)")
-    plan.add_argument("--to", dest="destination", metavar="X,Y,Z", help="destination, m (default: tracks.destination, P_D)")
+    plan.add_argument("--from", dest="origin", metavar="X,Y,Z|NAME",
+                      help="origin, m, or a vertiport name (default: tracks.route / tracks.origin)")
+    plan.add_argument("--to", dest="destination", metavar="X,Y,Z|NAME",
+                      help="destination, m, or a vertiport name (default: tracks.route / tracks.destination)")
     command("network", cmd_network, "plan one track per route and direction: network.json, network.png", "out/network")
+    flights = command("flights", cmd_flights, "generate the scenario's flight plan: flights.json (the instance "
+                      "generator)", "out/flights")
+    flights.add_argument("--seed", type=int, help="seed of the generated plan (default: schedule.plan_seed)")
     sched = command("schedule", cmd_schedule, "schedule the flights: flights.json, schedule.csv, summary.json", "out/schedule")
     for p in (sched,):
         p.add_argument("--solver", required=True, metavar="PROFILE", help="solver profile: solvers/NAME.toml or NAME")
@@ -413,6 +447,9 @@ def build_parser() -> argparse.ArgumentParser:
     verify.add_argument("dir", help="folder with flights.json and schedule.csv")
     verify.set_defaults(func=cmd_verify)
     command("reproduce", cmd_reproduce, "run every stage that applies and write report.md with figures", "out/reproduce")
+    from uamopt.export.cli import add_export_commands
+
+    add_export_commands(sub)  # export bluesky | geojson, replay
     return parser
 
 

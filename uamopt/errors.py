@@ -1,6 +1,6 @@
 """Named exceptions. The CLI turns every :class:`UamoptError` into one line and exit code 2.
 
-Every message follows INTERFACES.md: ``<what> (<where>): <how to fix>``.
+Every message follows docs/interfaces.md: ``<what> (<where>): <how to fix>``.
 """
 
 from __future__ import annotations

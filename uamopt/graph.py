@@ -3,7 +3,7 @@ fast planners of later stages.
 
 Nodes are passable cells (i, j, k) (neither obstacle nor no-fly; Eqs. 9 and 15 make both
 impassable). Edges join 26-neighbours; a move may not cut the corner of an impassable cell:
-every cell of the move's bounding box must be passable (MODEL_NOTES; this also reproduces the
+every cell of the move's bounding box must be passable (docs/readings.md; this also reproduces the
 Moving AI benchmark's optimal lengths).
 """
 

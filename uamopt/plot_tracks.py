@@ -339,8 +339,16 @@ def plot_tracks(model: PlanningModel, plan: TrackPlan, path: str | Path, *, titl
 
     Examples
     --------
-    >>> plan = plan_track(model, (300, 300, 120), (2220, 4220, 120))  # doctest: +SKIP
-    >>> plot_tracks(model, plan, "tracks.png", title="paper_case")  # doctest: +SKIP
+    >>> import tempfile
+    >>> from uamopt.planning import plan_track, planning_model
+    >>> from uamopt.scenario import Scenario
+    >>> from uamopt.stages import compute_risk
+    >>> scenario = Scenario().with_overrides(["grid.cell=[100,100,60]"])
+    >>> model = planning_model(scenario, compute_risk(scenario).field)
+    >>> plan = plan_track(model, (300, 300, 120), (2220, 4220, 120))
+    >>> png = plot_tracks(model, plan, Path(tempfile.mkdtemp()) / "tracks.png", title="Table B.3")
+    >>> png.name, png.stat().st_size > 50_000
+    ('tracks.png', True)
     """
     path = Path(path)
     field = model.field

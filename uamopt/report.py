@@ -13,7 +13,7 @@ from uamopt.risk import (
 )
 from uamopt.scenario import Scenario
 
-# MODEL_NOTES reference numbers (Table B.3, h' = 148.2 m), for m_p = 0 kg and 220 kg.
+# The reference numbers of docs/readings.md (Table B.3, h' = 148.2 m), for m_p = 0 kg and 220 kg.
 REFERENCE = {
     "terminal speed (m/s)": (27.468, 34.198),
     "v from h' = 148.2 m (A.3, m/s)": (27.174496, 32.740228),
@@ -75,7 +75,7 @@ def risk_section(scenario: Scenario, summary: dict) -> str:
         "",
         "### Appendix A reference numbers (h' = 148.2 m, Table B.3)",
         "",
-        "| quantity | ours, m_p = 0 | MODEL_NOTES | ours, m_p = 220 kg | MODEL_NOTES |",
+        "| quantity | ours, m_p = 0 | reference | ours, m_p = 220 kg | reference |",
         "|---|---|---|---|---|",
     ]
     for name, a, ra, b, rb in reference_rows(scenario):
@@ -111,82 +111,114 @@ def _change(value: float, base: float) -> str:
 
 
 def straight_segment_cost(scenario: Scenario, length_m: float = 4365.0) -> float:
-    """Eq. 12 for a straight level segment: c_h · L · c_e · τ(m_p) (MODEL_NOTES: ¥27.15)."""
+    """Eq. 12 for a straight level segment: c_h · L · c_e · τ(m_p) (docs/readings.md: ¥27.15)."""
     from uamopt.planning.problem import transport_rates
 
     return transport_rates(scenario)[0] * length_m
 
 
+def track_shape(tracks: dict, cruise_altitude_m: float, layer_m: float) -> dict:
+    """The paper's Table 2 shape, per stage: does the track stay within one cell layer of the cruise
+    altitude, and how its C_T and C_R compare with the shortest track's (%)."""
+    st = tracks["stages"]
+    base = st["shortest"]
+    shape = {}
+    for name, stage in st.items():
+        z = [p[2] for p in stage["waypoints"]]
+        deviation = max(abs(v - cruise_altitude_m) for v in z)
+        shape[name] = {
+            "max_altitude_deviation_m": deviation, "in_layer": deviation <= layer_m + 1e-6,
+            "d_cost_pct": 100 * (stage["transport_cost"] / base["transport_cost"] - 1),
+            "d_risk_pct": 100 * (stage["risk_cost"] / base["risk_cost"] - 1) if base["risk_cost"] else float("nan"),
+        }
+    return shape
+
+
 def table2_section(scenario: Scenario, model, tracks: dict, title: str = "Track planning: Table 2 analogue (Sec. 6.2, Fig. 18)",
-                   figure: bool = True) -> str:
-    """Table 2 analogue beside the paper's figures, with the cumulative computing time."""
+                   figure: bool = True, paper: bool = True) -> str:
+    """Table 2 analogue, with the paper's figures in brackets when ``paper`` (same P_O → P_D), and
+    the shape checks: each stage in its layer, Δcost and Δrisk against the shortest track."""
     st = tracks["stages"]
     names = ("shortest", "initial", "equivalent", "optimal")
-    cumulative = 0.0
-    times = []
-    for n in names:
-        cumulative += st[n]["seconds"]
-        times.append(cumulative)
+    ref = PAPER_TABLE2 if paper else {}
     rows = [
-        ("operational risk C_R (Eq. 11)", [st[n]["risk_cost"] for n in names], PAPER_TABLE2["operational risk"], ".1f"),
-        ("safety-buffer exposure Σ μ·R(t) (Eq. 34)", [st[n]["buffer_cost"] for n in names], None, ".0f"),
-        ("transport cost C_T (¥, Eq. 12)", [st[n]["transport_cost"] for n in names], PAPER_TABLE2["transport cost (¥)"], ".4f"),
-        ("waypoints", [st[n]["n_waypoints"] for n in names], PAPER_TABLE2["waypoints"], "d"),
-        ("length (m)", [st[n]["length_m"] for n in names], None, ".0f"),
-        ("computational time, cumulative (s)", times, PAPER_TABLE2["computational time (s)"], ".3f"),
+        ("operational risk C_R (Eq. 11)", [st[n]["risk_cost"] for n in names], ref.get("operational risk"), ".1f", True),
+        ("safety-buffer exposure Σ μ·R(t) (Eq. 34)", [st[n]["buffer_cost"] for n in names], None, ".0f", False),
+        ("transport cost C_T (¥, Eq. 12)", [st[n]["transport_cost"] for n in names], ref.get("transport cost (¥)"), ".4f", True),
+        ("waypoints", [st[n]["n_waypoints"] for n in names], ref.get("waypoints"), "d", False),
+        ("length (m)", [st[n]["length_m"] for n in names], None, ".0f", True),
+        ("computational time of the stage (s)", [st[n]["seconds"] for n in names], None, ".3f", False),
     ]
     g = model.field.grid
     o, d = tracks["origin"], tracks["destination"]
+    cruise = scenario.network.cruise_altitude_m
+    shape = track_shape(tracks, cruise, g.cell[2])
+    t = scenario.tracks
     lines = [
         f"## {title}",
         "",
         f"P_O = ({', '.join(f'{v:g}' for v in o)}) → P_D = ({', '.join(f'{v:g}' for v in d)}) m, cells "
-        f"{' × '.join(f'{c:g}' for c in g.cell)} m, ω4 = {scenario.tracks.weights[0]:g}, ω5 = {scenario.tracks.weights[1]:g}, "
-        f"μ = {scenario.tracks.buffer_penalty:g}, buffer n_s = {model.n_s}. Ours first, the paper's in brackets "
-        "(its instance, not ours: compare the shape). Changes are relative to the shortest track.",
+        f"{' × '.join(f'{c:g}' for c in g.cell)} m, ω4 = {t.weights[0]:g}, ω5 = {t.weights[1]:g}, "
+        f"μ = {t.buffer_penalty:g}, buffer n_s = {model.n_s}, R(t) = {t.buffer_measure}, charged on the "
+        f"{t.buffer_charge}. Changes in parentheses are relative to the shortest track"
+        + (", the paper's figures in brackets (its instance, not ours: compare the shape)." if paper else
+           "; the paper has no figures for this track."),
         "",
         "| index | shortest | initial | equivalent | optimal |",
         "|---|---|---|---|---|",
     ]
-    for label, ours, paper, fmt in rows:
+    for label, ours, paper_row, fmt, relative in rows:
         cells = []
         for i, v in enumerate(ours):
-            text = format(int(v) if fmt == "d" else v, fmt) + (_change(v, ours[0]) if i else "")
-            if paper is not None:
-                text += f" [{paper[i]:g}]"
+            text = format(int(v) if fmt == "d" else v, fmt) + (_change(v, ours[0]) if i and relative else "")
+            if paper_row is not None:
+                text += f" [{paper_row[i]:g}]"
             cells.append(text)
         lines.append(f"| {label} | " + " | ".join(cells) + " |")
-    mid = tracks.get("equivalent_midpoint_rule")
-    eq = st["equivalent"]
+    stays = ", ".join(f"{n} {'yes' if shape[n]['in_layer'] else 'NO'} ({shape[n]['max_altitude_deviation_m']:.0f} m)"
+                      for n in names)
+    ini = shape["initial"]
     lines += [
         "",
-        f"Equivalent track, exact shortest polyline through the corridor (SOCP): {eq['length_m']:.1f} m, "
-        f"¥{eq['transport_cost']:.4f}; the paper's midpoint rule: {mid['length_m']:.1f} m, ¥{mid['transport_cost']:.4f}."
-        if mid else "",
-        "",
-        f"Check of Eq. 12–13 (MODEL_NOTES): a straight level 4365 m segment with m_p = {scenario.aircraft.payload_kg:g} kg "
-        f"costs ¥{straight_segment_cost(scenario):.4f} (paper's shortest track: ¥27.1527).",
-        "",
-    ] + (["![tracks](tracks.png)", ""] if figure else [])
+        f"Shape checks: within one layer ({g.cell[2]:g} m) of the cruise altitude {cruise:g} m, largest deviation in "
+        f"parentheses: {stays}. Initial track against the shortest: C_T {ini['d_cost_pct']:+.1f} %, "
+        f"C_R {ini['d_risk_pct']:+.1f} %" + (" (paper: +20.6 %, −11.2 %)." if paper else "."),
+        "The shortest track minimises C_T alone and breaks ties between equally cheap tracks by least risk. "
+        "Waypoints: the shortest and initial tracks list their cell centres; the equivalent track's waypoints "
+        "are its corners; the optimal track adds the points of its corner curves. Times are each stage's own"
+        + (f"; compiling the search took {tracks['warmup_seconds']:.2f} s before the first stage and is in none."
+           if tracks.get("warmup_seconds") else "."),
+    ]
+    mid = tracks.get("equivalent_midpoint_rule")
+    eq = st["equivalent"]
+    if mid:
+        lines += ["", f"Equivalent track, exact shortest polyline through the corridor (SOCP): {eq['length_m']:.1f} m, "
+                  f"¥{eq['transport_cost']:.4f}; the paper's midpoint rule: {mid['length_m']:.1f} m, ¥{mid['transport_cost']:.4f}."]
+    if paper:
+        lines += ["", f"Check of Eq. 12–13: a straight level 4365 m segment with m_p = {scenario.aircraft.payload_kg:g} kg "
+                  f"costs ¥{straight_segment_cost(scenario):.4f} (paper's shortest track: ¥27.1527)."]
+    lines += [""] + (["![tracks](tracks.png)", ""] if figure else [])
     return "\n".join(lines) + "\n"
 
 
-def table4_section(scenario: Scenario, results: list) -> str:
-    """Table 4 analogue: the optimal track at finer cells (cell side, plan, seconds)."""
+def table4_section(scenario: Scenario, results: list, paper: bool = True) -> str:
+    """Table 4 analogue: the optimal track at finer cells (cell side, plan, seconds); the paper's
+    figures in brackets when ``paper`` (same P_O → P_D)."""
     if not results:
         return ""
     lines = [
         "## Track planning at finer cells: Table 4 analogue (Sec. 6.3.2)",
         "",
         "Optimal track P_O → P_D; computational time includes the risk field and planning model. "
-        "The paper's figures in brackets (its Table 4 reports the shortest-track column of Table 2).",
+        + ("The paper's figures in brackets (its Table 4 reports the shortest-track column of Table 2)."
+           if paper else "The paper has no figures for this track."),
         "",
         "| cells | operational risk C_R | transport cost (¥) | waypoints | length (m) | time (s) |",
         "|---|---|---|---|---|---|",
     ]
     for side, plan, seconds in results:
         o = plan.stages["optimal"]
-        p = PAPER_TABLE4.get(float(side))
+        p = PAPER_TABLE4.get(float(side)) if paper else None
         ref = (lambda i: f" [{p[i]:g}]") if p else (lambda i: "")
         lines.append(f"| {side:g} m | {o.risk_cost:.1f}{ref(0)} | {o.transport_cost:.4f}{ref(1)} | {o.n_waypoints}{ref(2)} | "
                      f"{o.length_m:.0f} | {seconds:.2f}{ref(3)} |")
@@ -209,34 +241,48 @@ def network_section(scenario: Scenario, doc: dict) -> str:
     return "\n".join(lines + ["", "![network](network.png)", ""]) + "\n"
 
 
-def pareto_section(scenario: Scenario, model, fronts: dict) -> str:
-    """Fig. 21 analogue: the (C_R, C_T) trade-off over ω4/ω5, without and with the buffer term."""
+def pareto_section(scenario: Scenario, model, fronts: dict, endpoints: tuple[str, str] = ("P_O", "P_D")) -> str:
+    """Fig. 21 analogue: the (C_R, C_T) trade-off over ω4/ω5, without and with the buffer term, and
+    the number of non-dominated points of each (the paper's Fig. 21 shows a front, not a point)."""
     from uamopt.planning.pareto import non_dominated
 
     g = model.field.grid
+    fronts_nd = {flag: non_dominated(fronts[flag]) for flag in (False, True)}
     lines = [
         "## Risk–cost trade-off: Fig. 21 analogue (Sec. 6.3.2)",
         "",
-        f"P_O → P_D at {' × '.join(f'{c:g}' for c in g.cell)} m cells, weights ω4/ω5 swept (ω4 + ω5 = 1). "
-        "Non-dominated points of Eq. 10 alone (μ = 0), and with the safety-buffer term μ·R(t) of Eq. 34 "
-        f"(μ = {scenario.tracks.buffer_penalty:g}), which dominates the objective and collapses the front.",
+        f"{endpoints[0]} → {endpoints[1]} at {' × '.join(f'{c:g}' for c in g.cell)} m cells, weights ω4/ω5 swept "
+        "(ω4 + ω5 = 1). Non-dominated points of Eq. 10 alone (μ = 0), and with the safety-buffer term μ·R(t) of "
+        f"Eq. 34 (μ = {scenario.tracks.buffer_penalty:g}, R(t) = {scenario.tracks.buffer_measure}).",
+        "",
+        f"Shape check: {len(fronts_nd[True])} non-dominated points with the buffer term "
+        f"({len(fronts[True])} searches), {len(fronts_nd[False])} without.",
         "",
         "| objective | ω4 | ω5 | C_R (Eq. 11) | C_T (¥, Eq. 12) |",
         "|---|---|---|---|---|",
     ]
     for flag, label in ((False, "Eq. 10"), (True, "Eq. 10 + μ·R(t)")):
-        for p in non_dominated(fronts[flag]):
+        for p in fronts_nd[flag]:
             lines.append(f"| {label} | {p.w4:.4g} | {p.w5:.4g} | {p.risk_cost:.1f} | {p.transport_cost:.4f} |")
     return "\n".join(lines + ["", "![pareto](pareto.png)", ""]) + "\n"
+
+
+def is_paper_schedule(scenario: Scenario, problem) -> bool:
+    """True when the flights are the paper's case (Table B.3 vertiports, 20 eVTOLs, 120 flights)."""
+    from uamopt.scenario import NetworkConfig
+
+    paper_ports = [(v.name, v.x, v.y) for v in NetworkConfig().vertiports]
+    ports = [(v.name, v.x, v.y) for v in scenario.network.vertiports]
+    return ports == paper_ports and problem.n_flights == 120 and problem.aircraft_count == 20
 
 
 # Table 3 of the paper (operated, cancelled, total delay s)
 PAPER_TABLE3 = {"greedy": (109, 11, 2401), "soa": (117, 3, 1911), "ga": (114, 6, 2161)}
 
 
-def table3_section(problem, schedules: dict, verified: dict, suffix: str = "") -> str:
+def table3_section(problem, schedules: dict, verified: dict, suffix: str = "", paper: bool = True) -> str:
     """Table 3 analogue: every solver on the same flights, with each one's distance to the proven
-    optimum (which the paper could not give)."""
+    optimum (which the paper could not give); the paper's figures in brackets when ``paper``."""
     exact = [s for s in schedules.values() if s.status == "optimal" and s.bound is not None]
     best = min((s.objective for s in exact), default=None)
     lines = [
@@ -244,7 +290,8 @@ def table3_section(problem, schedules: dict, verified: dict, suffix: str = "") -
         "",
         f"{problem.n_flights} flights, G = {problem.aircraft_count} aircraft, {len(problem.conflicts)} conflicting "
         f"pairs, objective Eq. 20 with (ω6, ω7) = {tuple(problem.weights)} ({problem.objective_kind}). "
-        "The paper's figures in brackets (operated / cancelled / total delay; its instance, not ours). "
+        + ("The paper's figures in brackets (operated / cancelled / total delay; its instance, not ours). "
+           if paper else "The paper has no figures for this instance. ") +
         "'to optimum' is the objective's distance to the proven optimum.",
         "",
         "| solver | status | operated | cancelled | total delay (s) | avg delay T_d (s) | objective | bound | "
@@ -252,7 +299,7 @@ def table3_section(problem, schedules: dict, verified: dict, suffix: str = "") -
         "|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for name, s in schedules.items():
-        p = PAPER_TABLE3.get(name)
+        p = PAPER_TABLE3.get(name) if paper else None
         ref = (lambda i: f" [{p[i]:g}]") if p else (lambda i: "")
         dist = "-" if best is None or s.objective is None else f"{s.objective - best:+.4f}"
         bound = "-" if s.bound is None else f"{s.bound:.4f}"

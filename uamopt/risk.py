@@ -1,6 +1,6 @@
 """Operational risk field (Sec. 4.1.1, App. A): Eqs. 1–9 and A.1–A.9, vectorised over every cell.
 
-Readings (MODEL_NOTES):
+Readings (docs/readings.md):
 
 - Each cell is evaluated separately; h' = centre altitude − surface height under it. A cell any
   part of which lies below the surface (inside or under a building) is an obstacle; its
@@ -199,7 +199,7 @@ class RiskField:
         return self.grid.layers_in_band(*self.band)
 
     def arrays(self) -> dict[str, np.ndarray]:
-        """The arrays of ``risk.npz`` (INTERFACES.md)."""
+        """The arrays of ``risk.npz`` (docs/interfaces.md)."""
         g = self.grid
         return {
             "risk": self.risk, "risk_P": self.risk_P, "risk_V": self.risk_V, "risk_U": self.risk_U,
@@ -207,11 +207,68 @@ class RiskField:
             "x": g.x, "y": g.y, "z": g.z, "cell": np.asarray(g.cell),
             "surface_height": self.city.surface_height, "building_height": self.city.building_height,
             "shelter": self.city.shelter, "road_length": self.city.road_length,
-            "population_density": self.city.population_density,
+            "population_density": self.city.population_density, "open_space": self.city.open_space,
         }
 
     def save_npz(self, path: str | Path) -> None:
         np.savez_compressed(path, **self.arrays())
+
+    def summary(self, seconds: dict | None = None) -> dict:
+        """Cell counts, unsafe shares (whole grid and altitude band), risk statistics and timings:
+        the content of the risk command's ``summary.json``. ``seconds`` defaults to
+        ``meta["seconds"]`` (city, risk, total) or this field's own computing time."""
+        g = self.grid
+        band = self.band_layers()
+        free = ~self.obstacle
+        in_band = np.zeros(g.shape[2], dtype=bool)
+        in_band[band] = True
+        band_free = free & in_band[None, None, :]
+        w = self.meta.get("weights", (0.5, 0.3, 0.2))
+
+        def share(mask, of):
+            n = int(of.sum())
+            return float(mask[of].sum() / n) if n else 0.0
+
+        with np.errstate(invalid="ignore"):
+            road_driven = (w[1] * self.risk_V > self.threshold) & free
+        risk_free = self.risk[free]
+        c = self.constants
+        return {
+            "scenario": self.meta.get("scenario", ""),
+            "source": self.city.source,
+            "attribution": self.city.attribution,
+            "crs": self.city.crs,
+            "origin": list(self.city.origin),
+            "grid": {"cell_m": list(g.cell), "shape": list(g.shape), "extent_m": list(g.extent)},
+            "cells": g.n_cells,
+            "obstacle_cells": int(self.obstacle.sum()),
+            "no_fly_cells": int((self.no_fly & free).sum()),
+            "unsafe_cells": int(self.unsafe.sum()),
+            "unsafe_share": float(self.unsafe.mean()),
+            "band_m": list(self.band),
+            "band_layers": [int(k) for k in band],
+            "band_free_cells": int(band_free.sum()),
+            "band_unsafe_share": share(self.unsafe, band_free),
+            "unsafe_share_by_layer": {f"{z:g}": share(self.unsafe[:, :, k], free[:, :, k]) for k, z in enumerate(g.z)},
+            "road_columns_share": float((self.city.road_length > 0).mean()),
+            "road_driven_unsafe_share": share(road_driven, free),
+            "risk_per_flight_hour": {
+                "threshold_R0": self.threshold,
+                "min": float(risk_free.min()) if risk_free.size else None,
+                "median": float(np.median(risk_free)) if risk_free.size else None,
+                "max": float(risk_free.max()) if risk_free.size else None,
+            },
+            "constants": {
+                "mass_kg": c.mass_kg,
+                "crash_area_m2": c.crash_area_m2,
+                "drag_k_per_m": c.k_per_m,
+                "terminal_speed_mps": c.terminal_speed_mps,
+                "mean_relative_speed_mps": c.mean_relative_speed_mps,
+                "vehicle_collision_probability": c.vehicle_collision_probability,
+            },
+            "city": self.city.notes,
+            "seconds": dict(seconds or self.meta.get("seconds") or {"risk": self.seconds}),
+        }
 
 
 def risk_field(scenario: Scenario, grid: AirspaceGrid, city: CityLayers) -> RiskField:
@@ -266,7 +323,7 @@ def risk_field(scenario: Scenario, grid: AirspaceGrid, city: CityLayers) -> Risk
     # One layer at a time: every operation is vectorised over the layer's columns, and the
     # temporaries stay the size of one layer (memory ~ outputs only, even at 5 m cells).
     for k, z in enumerate(grid.z):
-        # h' per cell (MODEL_NOTES); an obstacle is any cell reaching below the surface.
+        # h' per cell (docs/readings.md); an obstacle is any cell reaching below the surface.
         blocked = (z - 0.5 * grid.cell[2]) < city.surface_height - 1e-9
         height = np.where(blocked, np.nan, z - city.surface_height)
         decay = np.exp(-2.0 * c.k_per_m * height)  # e^{-2kh'}, shared by A.3 and the fall time
@@ -289,4 +346,5 @@ def risk_field(scenario: Scenario, grid: AirspaceGrid, city: CityLayers) -> Risk
         grid=grid, city=city, risk=risk, risk_P=risk_p, risk_V=risk_v, risk_U=risk_u,
         unsafe=unsafe, obstacle=obstacle, band=altitude_band(scenario), constants=c,
         threshold=r.threshold, seconds=time.perf_counter() - started,
+        meta={"scenario": scenario.name, "weights": tuple(r.weights)},
     )

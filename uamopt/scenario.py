@@ -5,7 +5,7 @@ unit stand beside each field (``description``) and ``uamopt keys`` would list th
 are validated once, here, at the boundary (STYLE.md); the library trusts them afterwards.
 
 Reading: ``load_scenario(path, overrides=["grid.cell=[10,10,10]"])``. Overrides use TOML value
-syntax with dotted keys (INTERFACES.md); a value that is not valid TOML is taken as a string, so
+syntax with dotted keys (docs/interfaces.md); a value that is not valid TOML is taken as a string, so
 ``--set city.source=osm`` works without quotes.
 """
 
@@ -16,13 +16,21 @@ import tomllib
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, PrivateAttr, ValidationError, ValidationInfo, field_validator
+from pydantic import (BaseModel, BeforeValidator, ConfigDict, Field, PrivateAttr, ValidationError, ValidationInfo, field_validator,
+                      model_validator)
 
 from uamopt.errors import ScenarioError
 
-PositiveFloat = Annotated[float, Field(gt=0, allow_inf_nan=False)]
-NonNegFloat = Annotated[float, Field(ge=0, allow_inf_nan=False)]
-Fraction = Annotated[float, Field(ge=0, le=1, allow_inf_nan=False)]
+def _number(value: Any) -> Any:
+    """Numbers only: TOML's true/false and "7" are not lengths or rates (strict at the boundary)."""
+    if isinstance(value, bool) or isinstance(value, str):
+        raise ValueError("must be a number")
+    return value
+
+
+PositiveFloat = Annotated[float, BeforeValidator(_number), Field(gt=0, allow_inf_nan=False)]
+NonNegFloat = Annotated[float, BeforeValidator(_number), Field(ge=0, allow_inf_nan=False)]
+Fraction = Annotated[float, BeforeValidator(_number), Field(ge=0, le=1, allow_inf_nan=False)]
 Vec3 = tuple[PositiveFloat, PositiveFloat, PositiveFloat]
 
 
@@ -39,13 +47,17 @@ class GridConfig(_Section):
     )
     h_min_airspace: NonNegFloat = Field(30.0, description="h'_min, lowest altitude of the airspace, m (Eq. 14)")
     h_max_airspace: PositiveFloat = Field(300.0, description="h'_max, highest altitude of the airspace, m (Eq. 14)")
+    memory_limit_gb: PositiveFloat | None = Field(
+        None, description="refuse grids whose run would need more memory than this, GB (about 160 bytes per cell); "
+        "omitted: 80 % of the machine's memory"
+    )
 
 
 class CityConfig(_Section):
     """Where the ground-truth city layers come from (synthetic, OpenStreetMap or a DSM GeoTIFF)."""
 
     source: Literal["synthetic", "osm", "dsm"] = Field("synthetic", description="layer source")
-    seed: int = Field(7, description="seed of the synthetic city generator")
+    seed: Annotated[int, Field(ge=0, strict=True)] = Field(7, description="seed of the synthetic city generator")
     population_density: NonNegFloat = Field(2.5e-4, description="ρ_P, people per m² (Table B.3), uniform")
     shelter_low: Fraction = Field(0.5, description="c_s where buildings are ≤ shelter_height_m or absent")
     shelter_high: Fraction = Field(0.75, description="c_s where buildings are > shelter_height_m (Table B.3)")
@@ -73,7 +85,7 @@ class AircraftConfig(_Section):
     payload_kg: NonNegFloat = Field(
         145.6,
         description="m_p, kg. Table B.3 gives no value; 145.6 kg reproduces Table 2's shortest-track "
-        "cost of ¥27.15 over 4365 m through Eqs. 12-13 (MODEL_NOTES)",
+        "cost of ¥27.15 over 4365 m through Eqs. 12-13 (docs/readings.md)",
     )
     payload_max_kg: PositiveFloat = Field(220.0, description="m_p max, kg")
     mass_max_kg: PositiveFloat = Field(650.0, description="m_max, maximum take-off mass, kg (Eq. 18)")
@@ -134,9 +146,32 @@ class Vertiport(_Section):
 
 
 def _paper_vertiports() -> tuple[Vertiport, ...]:
-    # Table B.3 gives V1..V5 in 10 m grid units (MODEL_NOTES): V1 = (30, 30) is (300 m, 300 m).
+    # Table B.3 gives V1..V5 in 10 m grid units (docs/readings.md): V1 = (30, 30) is (300 m, 300 m).
     pts = {"V1": (30, 30), "V2": (30, 422), "V3": (222, 30), "V4": (222, 422), "V5": (126, 226)}
     return tuple(Vertiport(name=n, x=10.0 * x, y=10.0 * y) for n, (x, y) in pts.items())
+
+
+def random_vertiports(n: int, extent_m: tuple[float, float], *, margin_m: float = 300.0, seed: int = 0,
+                      spacing_m: float = 500.0) -> tuple[Vertiport, ...]:
+    """``n`` vertiports V1..Vn at seeded random whole-metre points of [margin, extent − margin]²,
+    at least ``spacing_m`` apart.
+
+    >>> [(v.name, v.x, v.y) for v in random_vertiports(2, (2000.0, 2000.0), seed=1)]
+    [('V1', 1017.0, 1631.0), ('V2', 502.0, 1628.0)]
+    """
+    import numpy as np
+
+    rng = np.random.default_rng(seed)
+    pts: list[tuple[float, float]] = []
+    for _ in range(1000 * n):
+        if len(pts) == n:
+            break
+        p = tuple(float(np.round(rng.uniform(margin_m, e - margin_m))) for e in extent_m)
+        if all(math.dist(p, q) >= spacing_m for q in pts):
+            pts.append(p)  # type: ignore[arg-type]
+    if len(pts) < n:
+        raise ValueError(f"cannot place {n} vertiports {spacing_m:g} m apart in {extent_m[0]:g} x {extent_m[1]:g} m")
+    return tuple(Vertiport(name=f"V{i + 1}", x=x, y=y) for i, (x, y) in enumerate(pts))
 
 
 class NetworkConfig(_Section):
@@ -148,6 +183,25 @@ class NetworkConfig(_Section):
     vertiport_clearance_m: NonNegFloat = Field(
         150.0, description="radius kept free of buildings above h_min around each vertiport (synthetic city), m"
     )
+    random_vertiports: Annotated[int, Field(ge=2, le=200, strict=True)] | None = Field(
+        None, description="N: replace the vertiports by V1..VN at seeded random whole-metre points of the grid, "
+        "300 m from its edges and 500 m apart (benchmark instances); needs grid.extent"
+    )
+    vertiport_seed: Annotated[int, Field(ge=0, strict=True)] = Field(
+        0, description="seed of network.random_vertiports"
+    )
+    tracks: Literal["planned", "straight"] = Field(
+        "planned", description="the tracks flights fly: planned by A* through the city (Sec. 4.2), or straight "
+        "lines between vertiports, a->b at the cruise altitude and b->a r + 1 layers up (scheduler benchmarks)"
+    )
+
+    def route_list(self) -> list[tuple[str, str]]:
+        """The routes (a, b): ``routes`` as given, or every pair of vertiports in their order
+        (10 for V1–V5). Each route is flown both ways (a→b and b→a)."""
+        if self.routes is not None:
+            return [(a, b) for a, b in self.routes]
+        names = [v.name for v in self.vertiports]
+        return [(a, b) for i, a in enumerate(names) for b in names[i + 1:]]
 
     @field_validator("vertiports")
     @classmethod
@@ -173,16 +227,26 @@ class TracksConfig(_Section):
     weights: tuple[NonNegFloat, NonNegFloat] = Field((0.5, 0.5), description="(ω4, ω5) risk and transport (Eq. 10)")
     clearance_m: NonNegFloat = Field(50.0, description="s_min, building clearance, m (Eq. 15)")
     buffer_penalty: NonNegFloat = Field(100.0, description="μ, safety-buffer shell penalty (Eq. 35)")
-    buffer_measure: Literal["count", "share"] = Field(
-        "count", description="R(t) of Eq. 35: the number of unsafe cells on the buffer's outer shell (MODEL_NOTES), "
-        "or their share of the shell's cells (a variant that does not grow with finer cells)"
+    buffer_measure: Literal["structures", "count", "share"] = Field(
+        "structures", description="R(t) of Eq. 35: the obstacle and no-fly cells on the buffer's outer shell "
+        "(proximity to structures, default; docs/readings.md), or the number of unsafe (Eq. 9) cells on it "
+        "('count', the first reading), or their share of the shell's cells ('share')"
+    )
+    buffer_charge: Literal["path", "priority"] = Field(
+        "path", description="where μ·R(t) is charged: on the path cost, per cell entered (Eq. 34, default), or only "
+        "in the node priority φ′ of Eq. 34, not carried along the path ('priority')"
     )
     risk_model: Literal["binary", "continuous"] = Field("binary", description="Eq. 9 field or Eq. 8 field")
-    origin: tuple[float, float, float] = Field(
-        (300.0, 300.0, 120.0), description="P_O, default origin of `uamopt plan`, m (Table B.3: (30, 30, 120) in 10 m units)"
+    route: tuple[str, str] | None = Field(
+        None, description="the two vertiports (names) of the single-track comparison (Table 2, Table 4, Fig. 21) "
+        "and the default of `uamopt plan`, flown at network.cruise_altitude_m; omitted: the first vertiport and the "
+        "one farthest from it (V1 -> V4 = P_O -> P_D of Table B.3 in the paper case)"
     )
-    destination: tuple[float, float, float] = Field(
-        (2220.0, 4220.0, 120.0), description="P_D, default destination of `uamopt plan`, m (Table B.3: (222, 422, 120))"
+    origin: tuple[float, float, float] | None = Field(
+        None, description="P_O as x, y, z in metres, overriding tracks.route's first vertiport"
+    )
+    destination: tuple[float, float, float] | None = Field(
+        None, description="P_D as x, y, z in metres, overriding tracks.route's second vertiport"
     )
     table2_cell_m: PositiveFloat = Field(
         10.0, description="cell side (m) of the Table 2 comparison in `uamopt reproduce` (the paper's Table 2 is "
@@ -215,16 +279,22 @@ class ScheduleConfig(_Section):
     outbound_gap_s: NonNegFloat = Field(240.0, description="T_D, s (Eq. 28)")
     return_gap_s: NonNegFloat = Field(360.0, description="T_R, s (Eq. 28)")
     interference: NonNegFloat = Field(0.3, description="χ, interference degree coefficient (Eq. 23)")
-    aircraft: Annotated[int, Field(ge=1)] = Field(20, description="G, number of eVTOLs")
-    flights: Annotated[int, Field(ge=1)] = Field(120, description="f, planned flights")
-    time_step_s: PositiveFloat = Field(10.0, description="ΔT_a, s (Table B.3)")
-    conflict_radius: Annotated[int, Field(ge=0)] = Field(1, description="r: conflict zone of (2r+1)³ cells")
+    aircraft: Annotated[int, Field(ge=1, strict=True)] = Field(20, description="G, number of eVTOLs")
+    flights: Annotated[int, Field(ge=1, strict=True)] | None = Field(
+        None, description="total planned flights; ⌊flights/G⌋ per aircraft, the remainder one each over the first "
+        "aircraft. Omitted: F per aircraft from Eq. 23 (20 × 6 = 120 in the paper case). Set it to hold the number "
+        "of flights fixed while speed or the service window vary (the paper's Figs. 22-23)"
+    )
+    time_step_s: PositiveFloat = Field(
+        10.0, description="ΔT_a, s (Table B.3): the heuristics' delay grid and the grid of generated first departures"
+    )
+    conflict_radius: Annotated[int, Field(ge=0, le=10, strict=True)] = Field(1, description="r: conflict zone of (2r+1)³ cells")
     service_s: PositiveFloat = Field(3600.0, description="T_f − T_s, the service window, s (Eq. 23: gives F = 6)")
     first_departure_window_s: NonNegFloat = Field(
-        600.0, description="first planned departures of the aircraft are drawn in [T_s, T_s + window], s"
+        600.0, description="first planned departures of the aircraft are drawn in [T_s, T_s + window], s; an "
+        "aircraft whose flights leave less slack before T_f draws from that slack (noted in summary.json)"
     )
-    plan_seed: int = Field(0, description="seed of the initial flight plan generator")
-    departure_step_s: PositiveFloat = Field(1.0, description="grid of the generated first departures, s")
+    plan_seed: Annotated[int, Field(ge=0, strict=True)] = Field(0, description="seed of the initial flight plan generator")
     max_delay_scale: Annotated[float, Field(gt=0, le=1)] = Field(
         1.0, description="Δd as a share of Eq. 29's bound round(L/v_g) + ΔT (Eq. 29 allows any Δd up to it)"
     )
@@ -234,7 +304,7 @@ class ScheduleConfig(_Section):
 
 
 class Scenario(_Section):
-    """A whole scenario: one TOML file, sections as in INTERFACES.md."""
+    """A whole scenario: one TOML file, sections as in docs/interfaces.md."""
 
     name: str = "scenario"
     description: str = ""
@@ -245,6 +315,17 @@ class Scenario(_Section):
     network: NetworkConfig = NetworkConfig()
     tracks: TracksConfig = TracksConfig()
     schedule: ScheduleConfig = ScheduleConfig()
+
+    @model_validator(mode="after")
+    def _random_vertiports(self) -> "Scenario":
+        n = self.network.random_vertiports
+        if n is None:
+            return self
+        if self.grid.extent is None:
+            raise ValueError("network.random_vertiports needs grid.extent (the domain the vertiports are drawn in)")
+        ports = random_vertiports(n, (self.grid.extent[0], self.grid.extent[1]), seed=self.network.vertiport_seed)
+        object.__setattr__(self, "network", self.network.model_copy(update={"vertiports": ports, "routes": None}))
+        return self
 
     _base_dir: Path = PrivateAttr(default_factory=Path.cwd)
     _source: str = PrivateAttr(default="<defaults>")

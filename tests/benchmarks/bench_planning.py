@@ -4,9 +4,8 @@ Run on demand (not collected by pytest; several minutes, most of it the 8010 maz
 
     .venv/bin/python tests/benchmarks/bench_planning.py [--movingai-rows N] [--nx-cell 20] [--cells 10 5]
 
-(i)   Moving AI: every scenario row of both maps in tests/data/movingai (as in shared/benchmarks, beside the repo
-      root), fast backend with the transport heuristic: rows matching the optimal length to 1e-3,
-      and the total time.
+(i)   Moving AI: every scenario row of both maps in tests/data/movingai, fast backend with the
+      transport heuristic: rows matching the optimal length to 1e-3, and the total time.
 (ii)  The paper case at 10 m cells, P_O → P_D: time of ``planning_model`` and of ``plan_track``
       (all four stages), numba warmed up first on a tiny problem. Target: plan < 5 s.
 (iii) The peer in the same run: the initial-stage search with networkx's A* vs the fast backend

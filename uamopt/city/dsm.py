@@ -1,7 +1,7 @@
 """City layers from a digital surface model (DSM) GeoTIFF, through rasterio.
 
 The DSM must be in a projected CRS in metres (UTM, a national grid). The local frame's (0, 0) is
-the raster's (left, bottom) corner, x east, y north (MODEL_NOTES). Each grid column takes the
+the raster's (left, bottom) corner, x east, y north (docs/readings.md). Each grid column takes the
 maximum DSM value over its footprint (conservative: the column is an obstacle up to its highest
 point), then
 
@@ -70,6 +70,14 @@ def dsm_extent(scenario: "Scenario") -> tuple[float, float]:
     with _open(path, "city.dsm") as src:
         left, bottom, right, top = _check_frame(src, path)
     return right - left, top - bottom
+
+
+def dsm_frame(scenario: "Scenario") -> tuple[str, float, float]:
+    """(CRS, left, bottom): the DSM's projected CRS and the CRS coordinates of the local (0, 0), m."""
+    path = _dsm_path(scenario)
+    with _open(path, "city.dsm") as src:
+        left, bottom, _, _ = _check_frame(src, path)
+        return src.crs.to_string(), float(left), float(bottom)
 
 
 def _on_grid(src, grid: "AirspaceGrid", frame: tuple, resampling: Resampling) -> np.ndarray:

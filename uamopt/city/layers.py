@@ -31,7 +31,7 @@ class CityLayers:
     building_height : float array, m
         Height of the building above the ground; 0 where there is none.
     road_length : float array, m
-        l_r: length of road centre line inside the column's footprint (MODEL_NOTES).
+        l_r: length of road centre line inside the column's footprint (docs/readings.md).
     population_density : float array, 1/m²
         ρ_P under the column.
     shelter : float array
@@ -147,7 +147,7 @@ def segment_length_per_cell(segments: np.ndarray, grid: AirspaceGrid) -> np.ndar
 
 def shelter_rule(building_height: np.ndarray, cfg: CityConfig) -> np.ndarray:
     """c_s per column (Table B.3): ``shelter_high`` over buildings taller than
-    ``shelter_height_m`` (15 m), ``shelter_low`` elsewhere, including open ground (MODEL_NOTES)."""
+    ``shelter_height_m`` (15 m), ``shelter_low`` elsewhere, including open ground (docs/readings.md)."""
     return np.where(building_height > cfg.shelter_height_m, cfg.shelter_high, cfg.shelter_low).astype(float)
 
 

@@ -4,7 +4,7 @@ Buildings come with a height from the ``height`` tag, else ``building:levels`` Ã
 else a default; roads are the ways of pyrosm's ``driving`` network; parks, grass and water are
 kept as open space (maps only). Everything is projected to a local metric frame: a transverse
 Mercator centred on the data (scale 1 at the centre, so distortion over a city is < 1e-6), shifted
-so the south-west corner of the data's bounds is (0, 0), x east, y north (MODEL_NOTES).
+so the south-west corner of the data's bounds is (0, 0), x east, y north (docs/readings.md).
 
 The loader is cached per (file, bbox, heights, no-fly file): :func:`uamopt.city.source_extent`
 and :func:`uamopt.city.load_city` both call :func:`load_osm` for one scenario.

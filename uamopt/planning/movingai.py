@@ -10,7 +10,7 @@ IEEE TCIAIG 4(2), 2012) publish maps and start/goal pairs with their optimal oct
   ``bucket map width height start_x start_y goal_x goal_y optimal_length``.
 
 The lengths assume 8-neighbour moves (straight 1, diagonal √2) with no corner cutting — the
-planner's own move rule (MODEL_NOTES). A map is therefore a one-layer airspace with 1 m cells,
+planner's own move rule (docs/readings.md). A map is therefore a one-layer airspace with 1 m cells,
 no risk, no buffer penalty and a transport cost equal to the horizontal distance (c_h = 1,
 c_v = 0): the search cost of :func:`~uamopt.planning.search.grid_search` is the octile length.
 

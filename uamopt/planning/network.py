@@ -18,8 +18,8 @@ use the whole altitude band.
 from __future__ import annotations
 
 import dataclasses
-import itertools
 import json
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -31,10 +31,7 @@ from uamopt.planning.tracks import TrackPlan, plan_track
 
 def route_pairs(model: PlanningModel) -> list[tuple[str, str]]:
     """The scenario's routes, or every pair of vertiports (10 for V1–V5)."""
-    net = model.scenario.network
-    if net.routes is not None:
-        return [tuple(r) for r in net.routes]  # type: ignore[misc]
-    return list(itertools.combinations([v.name for v in net.vertiports], 2))
+    return model.scenario.network.route_list()
 
 
 def direction_layers(model: PlanningModel) -> tuple[int, int]:
@@ -56,8 +53,89 @@ def _confined(model: PlanningModel, k: int) -> PlanningModel:
     return dataclasses.replace(model, admissible=mask, risk=np.where(mask, model.risk, 0.0))
 
 
-def plan_network(model: PlanningModel, progress=None) -> dict[str, tuple[str, str, TrackPlan, int | None]]:
-    """Plan every route in both directions: name ``"A-B"`` → (origin, destination, plan, layer k)."""
+@dataclass(frozen=True, eq=False)
+class RouteTrack:
+    """One directed route of the network and its planned track (the ``optimal`` stage by default)."""
+
+    name: str
+    origin: str
+    destination: str
+    waypoints: np.ndarray  # (n, 3), m
+    length_m: float
+    risk_cost: float  # Eq. 11
+    transport_cost: float  # Eq. 12, ¥
+    buffer_cost: float  # Σ μ·R(t), Eq. 34
+    layer_k: int | None  # the cell layer the track is confined to (directional layering), or None
+    plan: TrackPlan | None = None  # all four stages, when planned in this process (not in network.json)
+
+
+@dataclass(frozen=True, eq=False)
+class RouteNetwork:
+    """Every route in both directions (``"A-B"`` → :class:`RouteTrack`): what ``network.json`` holds."""
+
+    routes: dict[str, RouteTrack]
+    cell: tuple[float, float, float]
+    scenario: str = ""
+    stage: str = "optimal"
+    layering: str = "direction"
+
+    def __len__(self) -> int:
+        return len(self.routes)
+
+    def __iter__(self):
+        return iter(self.routes)
+
+    def __getitem__(self, name: str) -> RouteTrack:
+        return self.routes[name]
+
+    def waypoints(self) -> dict[str, np.ndarray]:
+        """Route name → (n, 3) waypoints: the tracks the flights fly."""
+        return {name: r.waypoints for name, r in self.routes.items()}
+
+    def to_frame(self):
+        """One row per directed route: origin, destination, layer_k, length_m, risk_cost,
+        transport_cost, buffer_cost, n_waypoints (pandas DataFrame indexed by route)."""
+        import pandas as pd
+
+        rows = [{"route": r.name, "origin": r.origin, "destination": r.destination, "layer_k": r.layer_k,
+                 "length_m": r.length_m, "risk_cost": r.risk_cost, "transport_cost": r.transport_cost,
+                 "buffer_cost": r.buffer_cost, "n_waypoints": len(r.waypoints)} for r in self.routes.values()]
+        return pd.DataFrame(rows).set_index("route")
+
+    def to_document(self) -> dict:
+        """The JSON document of ``network.json`` (module docstring)."""
+        routes = {name: {"origin": r.origin, "destination": r.destination, "waypoints": r.waypoints.tolist(),
+                         "length_m": r.length_m, "risk_cost": r.risk_cost, "transport_cost": r.transport_cost,
+                         "buffer_cost": r.buffer_cost, "layer_k": r.layer_k} for name, r in self.routes.items()}
+        return {"scenario": self.scenario, "cell": list(self.cell), "stage": self.stage, "layering": self.layering,
+                "routes": routes}
+
+    @classmethod
+    def from_document(cls, doc: dict) -> RouteNetwork:
+        routes = {}
+        for name, r in doc["routes"].items():
+            waypoints = np.asarray(r["waypoints"], dtype=float)
+            if waypoints.ndim != 2 or waypoints.shape[1] != 3 or len(waypoints) < 2:
+                raise ValueError(f"route {name}: waypoints must be a list of at least two [x, y, z]")
+            routes[name] = RouteTrack(
+                name=name, origin=str(r.get("origin", name.split("-")[0])),
+                destination=str(r.get("destination", name.split("-")[-1])), waypoints=waypoints,
+                length_m=float(r.get("length_m", np.linalg.norm(np.diff(waypoints, axis=0), axis=1).sum())),
+                risk_cost=float(r.get("risk_cost", np.nan)), transport_cost=float(r.get("transport_cost", np.nan)),
+                buffer_cost=float(r.get("buffer_cost", np.nan)),
+                layer_k=None if r.get("layer_k") is None else int(r["layer_k"]))
+        cell = tuple(float(c) for c in doc.get("cell", (np.nan, np.nan, np.nan)))
+        return cls(routes=routes, cell=cell, scenario=str(doc.get("scenario", "")),  # type: ignore[arg-type]
+                   stage=str(doc.get("stage", "optimal")), layering=str(doc.get("layering", "direction")))
+
+
+def plan_network(model: PlanningModel, progress=None, stage: str = "optimal") -> RouteNetwork:
+    """Plan every route in both directions (Sec. 6.2, layering as in the module docstring).
+
+    ``progress`` (optional) gets ``update(1)`` after each track; ``stage`` picks the track the
+    flights fly (Table 2's ``optimal`` by default)."""
+    if model.scenario.network.tracks == "straight":
+        return straight_routes(model, progress)
     ports = {v.name: v for v in model.scenario.network.vertiports}
     layered = model.scenario.tracks.layering == "direction"
     dz = model.field.grid.cell[2]
@@ -65,7 +143,7 @@ def plan_network(model: PlanningModel, progress=None) -> dict[str, tuple[str, st
     if layered:
         k_out, k_back = direction_layers(model)
         confined = {k_out: _confined(model, k_out), k_back: _confined(model, k_back)}
-    out: dict[str, tuple[str, str, TrackPlan, int | None]] = {}
+    routes: dict[str, RouteTrack] = {}
     for a, b in route_pairs(model):
         for origin, destination, up in ((a, b, False), (b, a, True)):
             z = cruise + ((k_back - k_out) * dz if (layered and up) else 0.0)
@@ -76,32 +154,60 @@ def plan_network(model: PlanningModel, progress=None) -> dict[str, tuple[str, st
                 plan = plan_track(sub, (p.x, p.y, z), (q.x, q.y, z))
             except NoTrackError as exc:
                 raise NoTrackError(f"route {origin}-{destination}: {exc.what}", exc.where, exc.fix) from None
-            out[f"{origin}-{destination}"] = (origin, destination, plan, k)
+            s = plan.stages[stage]
+            name = f"{origin}-{destination}"
+            routes[name] = RouteTrack(name, origin, destination, s.waypoints, s.length_m, s.risk_cost,
+                                      s.transport_cost, s.buffer_cost, k, plan)
             if progress is not None:
                 progress.update(1)
-    return out
+    return RouteNetwork(routes, tuple(model.field.grid.cell), model.scenario.name, stage,  # type: ignore[arg-type]
+                        model.scenario.tracks.layering)
 
 
-def network_document(model: PlanningModel, network: dict, stage: str = "optimal") -> dict:
-    """The JSON document of ``network.json``."""
-    routes = {}
-    for name, (origin, destination, plan, k) in network.items():
-        s = plan.stages[stage]
-        routes[name] = {"origin": origin, "destination": destination, "waypoints": s.waypoints.tolist(),
-                        "length_m": s.length_m, "risk_cost": s.risk_cost, "transport_cost": s.transport_cost,
-                        "buffer_cost": s.buffer_cost, "layer_k": k}
-    return {"scenario": model.scenario.name, "cell": list(model.field.grid.cell), "stage": stage,
-            "layering": model.scenario.tracks.layering, "routes": routes}
+def straight_routes(model: PlanningModel, progress=None) -> RouteNetwork:
+    """``network.tracks = "straight"``: each direction a straight line between its vertiports, on
+    the layers of :func:`direction_layers` (a→b at the cruise altitude, b→a r + 1 layers up); the
+    city is not avoided. Metrics are Eqs. 10–12 of the line (scheduler benchmarks)."""
+    from uamopt.planning.tracks import track_metrics
+
+    ports = {v.name: v for v in model.scenario.network.vertiports}
+    k_out, k_back = direction_layers(model)
+    cruise, dz = model.scenario.network.cruise_altitude_m, model.field.grid.cell[2]
+    extent = np.asarray(model.field.grid.extent)
+    routes: dict[str, RouteTrack] = {}
+    for a, b in route_pairs(model):
+        for origin, destination, k in ((a, b, k_out), (b, a, k_back)):
+            z = cruise + (k - k_out) * dz
+            p, q = ports[origin], ports[destination]
+            waypoints = np.array([[p.x, p.y, z], [q.x, q.y, z]], dtype=float)
+            if np.any(waypoints < 0) or np.any(waypoints > extent):
+                raise NoTrackError(f"route {origin}-{destination} leaves the grid (extent {tuple(extent.tolist())})",
+                                   "network.vertiports", "move the vertiports inside grid.extent")
+            m = track_metrics(model, waypoints)
+            name = f"{origin}-{destination}"
+            routes[name] = RouteTrack(name, origin, destination, waypoints, m["length_m"], m["risk_cost"],
+                                      m["transport_cost"], m["buffer_cost"], k)
+            if progress is not None:
+                progress.update(1)
+    return RouteNetwork(routes, tuple(model.field.grid.cell), model.scenario.name, "straight",  # type: ignore[arg-type]
+                        model.scenario.tracks.layering)
 
 
-def load_network(path: str | Path) -> dict[str, np.ndarray]:
-    """Route name → waypoints (n, 3) from a ``network.json``."""
+def network_document(model: PlanningModel, network: RouteNetwork) -> dict:
+    """The JSON document of ``network.json`` (kept for callers of the first API)."""
+    return network.to_document()
+
+
+def load_network(path: str | Path) -> RouteNetwork:
+    """A :class:`RouteNetwork` from ``network.json`` (a file, or the folder holding it)."""
     path = Path(path)
+    if path.is_dir():
+        path = path / "network.json"
     try:
         doc = json.loads(path.read_text(encoding="utf-8"))
-        return {name: np.asarray(r["waypoints"], dtype=float) for name, r in doc["routes"].items()}
+        return RouteNetwork.from_document(doc)
     except FileNotFoundError:
         raise InputFileError(f"network file not found: {path}", "network.json", "run `uamopt network` first") from None
-    except (ValueError, KeyError, TypeError) as exc:
+    except (ValueError, KeyError, TypeError, AttributeError) as exc:
         raise InputFileError(f"malformed network file {path}: {exc}", "network.json",
                              "regenerate it with `uamopt network`") from None

@@ -29,6 +29,7 @@ from pathlib import Path
 import numpy as np
 from matplotlib.figure import Figure
 
+from uamopt.planning.endpoints import as_endpoint
 from uamopt.planning.problem import PlanningModel
 from uamopt.planning.search import grid_search
 from uamopt.planning.tracks import STAGES, TrackPlan, endpoint_cell, track_metrics
@@ -118,8 +119,9 @@ def weight_sweep(model: PlanningModel, origin, destination, weights: int | Seque
     UamoptError, NoTrackError
         As :func:`plan_track`, for the end points.
     """
-    start = endpoint_cell(model, np.asarray(origin, dtype=float), "origin")
-    goal = endpoint_cell(model, np.asarray(destination, dtype=float), "destination")
+    o, d = as_endpoint(model.scenario, origin, "origin"), as_endpoint(model.scenario, destination, "destination")
+    start = endpoint_cell(model, np.asarray(o.point, dtype=float), "origin", o.where)
+    goal = endpoint_cell(model, np.asarray(d.point, dtype=float), "destination", d.where)
     eps = tie_break_weights(model)
     if not isinstance(weights, (int, np.integer)):
         pairs = [_checked_pair(p, eps) for p in weights]
@@ -182,8 +184,19 @@ def pareto_front(model: PlanningModel, origin, destination, weights: int | Seque
 
     Examples
     --------
-    >>> front = pareto_front(model, (300, 300, 120), (2220, 4220, 120), 9)  # doctest: +SKIP
-    >>> [(round(p.transport_cost, 2), round(p.risk_cost)) for p in front]  # doctest: +SKIP
+    Table B.3's synthetic city on 100 m cells, V1 → V4 at 120 m:
+
+    >>> from uamopt.planning import planning_model
+    >>> from uamopt.scenario import Scenario
+    >>> from uamopt.stages import compute_risk
+    >>> scenario = Scenario().with_overrides(["grid.cell=[100,100,60]"])
+    >>> model = planning_model(scenario, compute_risk(scenario).field)
+    >>> front = pareto_front(model, (300, 300, 120), (2220, 4220, 120), 5, buffer=False)
+    >>> [(round(p.risk_cost), round(p.transport_cost, 2)) for p in front]
+    [(3068, 29.15), (2985, 29.52), (2902, 30.25), (2861, 30.61), (2744, 97.11)]
+    >>> with_buffer = pareto_front(model, (300, 300, 120), (2220, 4220, 120), 5)  # plus μ·R(t), Eq. 34
+    >>> [(round(p.risk_cost), round(p.transport_cost, 2)) for p in with_buffer]
+    [(3206, 99.08), (3002, 99.81), (2961, 100.18)]
     """
     return non_dominated(weight_sweep(model, origin, destination, weights, buffer=buffer))
 

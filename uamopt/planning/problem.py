@@ -1,15 +1,24 @@
 """The single-aircraft track planning model (Sec. 4.2, 5.1): admissible cells, costs, buffer.
 
-Readings (MODEL_NOTES, paper Sec. 5.1):
+Readings (docs/readings.md, paper Sec. 5.1):
 
 - Admissible cells: passable (not an obstacle, not a no-fly zone; Eq. 9/15), centre altitude in
-  the band of Eq. 14, and centre at least s_min from the centre of every obstacle cell (Eq. 15).
+  the band of Eq. 14, and centre at least s_min from the centre of every *building* cell (Eq. 15).
+  A building cell is an obstacle cell in a column whose surface stands more than
+  ``city.building_min_height_m`` above the ground (``building_height > 0``); a lower bump (trees,
+  cars in a DSM) is an obstacle the track cannot enter but not a clearance source.
   A continuous track is admissible when every point of it lies in admissible cells.
 - Safety buffer (Eqs. 34–35): a box of n_s cells per axis around the cell entered,
-  (``tracks.buffer_measure = "share"`` divides R(t) by the shell's cell count: a variant),
-  n_s = ⌈s_min/Δ⌉·2 + 1 (50 m cells → 3, 30 m layers → 5); R(t) counts the unsafe cells (Eq. 9:
-  risky, obstacle or no-fly) on the box's outer shell; the move pays μ·R(t). Cells outside the
-  grid count as unsafe. Computed for all cells at once with a 3-D summed-area table.
+  n_s = ⌈s_min/Δ⌉·2 + 1 (50 m cells → 3, 30 m layers → 5); R(t) counts the obstacle and no-fly
+  cells on the box's outer shell (``tracks.buffer_measure = "structures"``, default): the buffer is
+  "a safety margin between the aircraft and obstructions" (Sec. 5.1), while risk is already
+  charged by Eq. 11. Counting every unsafe (road) cell instead makes one shell cell weigh about
+  twenty risky steps at 10 m cells, and the planner climbs 120 → 265 m for +553 % transport cost,
+  far from the paper's shape; that reading stays as the variant ``"count"``, with ``"share"``
+  (the unsafe share of the shell). Cells outside the grid count as occupied. The move pays
+  μ·R(t) on entering the cell (``tracks.buffer_charge = "path"``), or μ·R(t) only orders the
+  search's open list (φ′ of Eq. 34, variant ``"priority"``). Computed for all cells at once with
+  a 3-D summed-area table.
 - Transport cost (Eqs. 12–13): c_h·horizontal + c_v·|vertical| times c_e·τ(m_p),
   τ = 1 + (m_p/m_p,max)·τ_max.
 - Risk cost (Eq. 11) uses the binary field of Eq. 9 by default (``tracks.risk_model``), the
@@ -68,27 +77,31 @@ def box_counts(mask: np.ndarray, half: tuple[int, int, int], outside: bool = Fal
     return inside + (volume - (x1 - x0) * (y1 - y0) * (z1 - z0)).astype(np.int32)
 
 
-def buffer_shell_count(unsafe: np.ndarray, n_s: tuple[int, int, int]) -> np.ndarray:
-    """R(t) of Eq. 35 for every cell: unsafe cells on the outer shell of its n_s box.
+def buffer_shell_count(occupied: np.ndarray, n_s: tuple[int, int, int]) -> np.ndarray:
+    """R(t) of Eq. 35 for every cell: ``occupied`` cells on the outer shell of its n_s box.
 
-    Cells beyond the grid count as unsafe: airspace outside the modelled city is not known to be
-    safe, and counting it safe would make the domain's edge the most attractive place to fly.
+    Cells beyond the grid count as occupied: airspace outside the modelled city is not known to be
+    safe, and counting it free would make the domain's edge the most attractive place to fly.
+
+    >>> solid = np.zeros((5, 5, 5), dtype=bool); solid[0, 2, 2] = True
+    >>> int(buffer_shell_count(solid, (3, 3, 3))[1, 2, 2]), int(buffer_shell_count(solid, (3, 3, 3))[2, 2, 2])
+    (1, 0)
     """
     outer = tuple((n - 1) // 2 for n in n_s)
     inner = tuple(h - 1 for h in outer)
-    full = box_counts(unsafe, outer, outside=True)
+    full = box_counts(occupied, outer, outside=True)
     if min(inner) < 0:
         return full
-    return full - box_counts(unsafe, inner, outside=True)  # type: ignore[arg-type]
+    return full - box_counts(occupied, inner, outside=True)  # type: ignore[arg-type]
 
 
-def clearance_ok(obstacle: np.ndarray, cell: tuple[float, float, float], clearance_m: float) -> np.ndarray:
-    """Cells whose centre is at least s_min from the centre of every obstacle cell (Eq. 15)."""
-    if clearance_m <= 0 or not obstacle.any():
-        return np.ones(obstacle.shape, dtype=bool)
-    if obstacle.all():
-        return np.zeros(obstacle.shape, dtype=bool)
-    distance = ndimage.distance_transform_edt(~obstacle, sampling=cell)
+def clearance_ok(building: np.ndarray, cell: tuple[float, float, float], clearance_m: float) -> np.ndarray:
+    """Cells whose centre is at least s_min from the centre of every building cell (Eq. 15)."""
+    if clearance_m <= 0 or not building.any():
+        return np.ones(building.shape, dtype=bool)
+    if building.all():
+        return np.zeros(building.shape, dtype=bool)
+    distance = ndimage.distance_transform_edt(~building, sampling=cell)
     return distance >= clearance_m - 1e-9
 
 
@@ -106,7 +119,7 @@ class PlanningModel:
     field: RiskField
     admissible: np.ndarray  # bool (nx, ny, nz)
     risk: np.ndarray  # R used in Eq. 11 (binary or continuous), 0 in inadmissible cells
-    shell_count: np.ndarray  # R(t) of Eq. 35: unsafe shell cells, or their share (tracks.buffer_measure)
+    shell_count: np.ndarray  # R(t) of Eq. 35 per cell (tracks.buffer_measure)
     n_s: tuple[int, int, int]
     c_h: float  # c_h c_e τ, ¥/m
     c_v: float  # c_v c_e τ, ¥/m
@@ -123,6 +136,9 @@ class PlanningModel:
         if stage != "initial":
             raise ValueError(f"stage must be 'shortest' or 'initial', got {stage!r}")
         penalty = self.scenario.tracks.buffer_penalty * self.shell_count
+        if self.scenario.tracks.buffer_charge == "priority":
+            return SearchProblem(self.admissible, self.risk, np.zeros(penalty.shape), self.field.grid.cell, w_risk,
+                                 w_transport * self.c_h, w_transport * self.c_v, priority=penalty)
         return SearchProblem(self.admissible, self.risk, penalty, self.field.grid.cell, w_risk,
                              w_transport * self.c_h, w_transport * self.c_v)
 
@@ -142,6 +158,12 @@ def check_aircraft_limits(scenario: Scenario) -> None:
                           "tracks.wind_speed_mps (Eq. 19)", "plan for a calmer wind or another aircraft")
 
 
+def building_cells(field: RiskField) -> np.ndarray:
+    """Obstacle cells of columns with a building (surface above ``city.building_min_height_m``):
+    the cells s_min is measured from (Eq. 15)."""
+    return field.obstacle & (field.city.building_height > 0)[:, :, None]
+
+
 def planning_model(scenario: Scenario, field: RiskField) -> PlanningModel:
     """Admissible cells, Eq. 11 risk, the buffer's shell counts and transport rates."""
     check_aircraft_limits(scenario)
@@ -150,15 +172,17 @@ def planning_model(scenario: Scenario, field: RiskField) -> PlanningModel:
     in_band = np.zeros(grid.shape[2], dtype=bool)
     in_band[field.band_layers()] = True
     admissible = ~(field.obstacle | field.no_fly) & in_band[None, None, :]
-    admissible &= clearance_ok(field.obstacle, grid.cell, s_min)
+    admissible &= clearance_ok(building_cells(field), grid.cell, s_min)
     if scenario.tracks.risk_model == "binary":
         risk = field.unsafe.astype(float)
     else:
         risk = np.nan_to_num(field.risk, nan=0.0)
     risk = np.where(admissible, risk, 0.0)
     n_s = buffer_cells(grid.cell, s_min)
-    shell = buffer_shell_count(field.unsafe, n_s).astype(float)
-    if scenario.tracks.buffer_measure == "share":
+    measure = scenario.tracks.buffer_measure
+    occupied = (field.obstacle | field.no_fly) if measure == "structures" else field.unsafe
+    shell = buffer_shell_count(occupied, n_s).astype(float)
+    if measure == "share":
         # Variant: the unsafe share of the shell. With the count, the shell holds 26 cells at 50 m
         # but 602 at 10 m, so μ·R(t) grows 23-fold with resolution and outweighs Eq. 10 entirely.
         inner = [max(n - 2, 0) for n in n_s]

@@ -28,15 +28,16 @@ import numpy as np
 
 from uamopt.errors import GridError, NoTrackError, UamoptError
 from uamopt.geometry import polyline_in_mask, polyline_pieces
+from uamopt.planning.endpoints import as_endpoint
 from uamopt.planning.problem import PlanningModel
-from uamopt.planning.search import grid_search
+from uamopt.planning.search import grid_search, warm_up
 
 STAGES = ("shortest", "initial", "equivalent", "optimal")
 
 
 @dataclass(frozen=True)
 class TrackStage:
-    """One stage's track and its metrics (INTERFACES.md ``tracks.json``)."""
+    """One stage's track and its metrics (docs/interfaces.md ``tracks.json``)."""
 
     name: str
     waypoints: np.ndarray  # (n, 3), m
@@ -82,21 +83,28 @@ def _stage(model: PlanningModel, name: str, waypoints: np.ndarray, seconds: floa
                       **track_metrics(model, waypoints))
 
 
-def endpoint_cell(model: PlanningModel, point, label: str) -> tuple[int, int, int]:
-    """The cell of an origin/destination, with a clear error when it cannot be flown from."""
+def endpoint_cell(model: PlanningModel, point, label: str, where: str | None = None) -> tuple[int, int, int]:
+    """The cell of an origin/destination, with a clear error when it cannot be flown from.
+    ``where`` names how the user gave the point (``--from Kamppi``, ``tracks.route``)."""
     grid, field_ = model.field.grid, model.field
-    where = f"--{'from' if label == 'origin' else 'to'} {','.join(f'{v:g}' for v in point)}"
+    if where is None:
+        where = f"{label} ({', '.join(f'{v:g}' for v in point)})"
     try:
         cell = grid.index_of(tuple(point))
     except GridError:
-        raise UamoptError(f"{label} {tuple(point)} is outside the grid", where,
+        shown = "(" + ", ".join(f"{float(v):g}" for v in point) + ")"
+        raise UamoptError(f"{label} {shown} is outside the grid", where,
                           f"give x, y, z inside {tuple(round(e, 1) for e in grid.extent)} m") from None
     low, high = field_.band
     if not low <= point[2] <= high:
         raise UamoptError(f"{label} altitude {point[2]:g} m is outside the band {low:g}-{high:g} m (Eq. 14)", where,
                           "choose an altitude inside the band")
     if field_.obstacle[cell]:
-        raise UamoptError(f"{label} is inside a building (cell {cell})", where, "move it above the roofs or into the street")
+        if field_.city.building_height[cell[:2]] > 0:
+            raise UamoptError(f"{label} is inside a building (cell {cell})", where, "move it above the roofs or into the street")
+        raise UamoptError(f"{label} is inside a low obstacle (cell {cell}: surface up to "
+                          f"{field_.city.surface_height[cell[:2]]:.1f} m, below city.building_min_height_m, e.g. trees)",
+                          where, "move it above the obstacle")
     if field_.no_fly[cell]:
         raise UamoptError(f"{label} is inside a no-fly zone (cell {cell})", where, "move it out of the zone")
     if not model.admissible[cell]:
@@ -261,10 +269,39 @@ class TrackPlan:
     destination: tuple[float, float, float]
     stages: dict[str, TrackStage]
     midpoint: TrackStage | None = None
+    warmup_seconds: float = 0.0  # compiling the search before the first stage (not in any stage's time)
+
+    def to_frame(self):
+        """One row per stage (Table 2): risk_cost C_R, transport_cost C_T, objective, buffer_cost,
+        length_m, n_waypoints, seconds (pandas DataFrame indexed by stage)."""
+        import pandas as pd
+
+        rows = [{"stage": name, "risk_cost": s.risk_cost, "transport_cost": s.transport_cost,
+                 "objective": s.objective, "buffer_cost": s.buffer_cost, "length_m": s.length_m,
+                 "n_waypoints": s.n_waypoints, "seconds": s.seconds} for name, s in self.stages.items()]
+        return pd.DataFrame(rows).set_index("stage")
+
+    @classmethod
+    def from_dict(cls, doc: dict) -> TrackPlan:
+        """The plan of a ``tracks.json`` document (:meth:`as_dict`)."""
+        def stage(name: str, d: dict) -> TrackStage:
+            core = {"waypoints", "risk_cost", "transport_cost", "objective", "buffer_cost", "n_waypoints",
+                    "length_m", "seconds"}
+            return TrackStage(name=name, waypoints=np.asarray(d["waypoints"], dtype=float), risk_cost=float(d["risk_cost"]),
+                              transport_cost=float(d["transport_cost"]), objective=float(d["objective"]),
+                              buffer_cost=float(d.get("buffer_cost", 0.0)), length_m=float(d["length_m"]),
+                              seconds=float(d["seconds"]), extra={k: v for k, v in d.items() if k not in core})
+
+        mid = doc.get("equivalent_midpoint_rule")
+        return cls(tuple(map(float, doc["origin"])), tuple(map(float, doc["destination"])),  # type: ignore[arg-type]
+                   {name: stage(name, d) for name, d in doc["stages"].items()},
+                   midpoint=stage("equivalent", mid) if mid else None,
+                   warmup_seconds=float(doc.get("warmup_seconds", 0.0)))
 
     def as_dict(self) -> dict:
         out = {"stages": {k: v.as_dict() for k, v in self.stages.items()},
-               "origin": list(self.origin), "destination": list(self.destination)}
+               "origin": list(self.origin), "destination": list(self.destination),
+               "warmup_seconds": self.warmup_seconds}
         if self.midpoint is not None:
             out["equivalent_midpoint_rule"] = self.midpoint.as_dict()
         return out
@@ -272,7 +309,8 @@ class TrackPlan:
 
 def plan_track(model: PlanningModel, origin, destination, *, backend: str | None = None,
                heuristic: str | None = None) -> TrackPlan:
-    """Plan all four stages from ``origin`` to ``destination`` (x, y, z in metres).
+    """Plan all four stages from ``origin`` to ``destination``: (x, y, z) in metres, vertiport
+    names (at the cruise altitude) or :class:`~uamopt.planning.endpoints.Endpoint`.
 
     Raises
     ------
@@ -285,12 +323,13 @@ def plan_track(model: PlanningModel, origin, destination, *, backend: str | None
     cfg = model.scenario.tracks
     backend = backend or cfg.search
     heuristic = heuristic or cfg.heuristic
-    origin = np.asarray(origin, dtype=float)
-    destination = np.asarray(destination, dtype=float)
-    start, goal = endpoint_cell(model, origin, "origin"), endpoint_cell(model, destination, "destination")
+    o, d = as_endpoint(model.scenario, origin, "origin"), as_endpoint(model.scenario, destination, "destination")
+    origin, destination = np.asarray(o.point, dtype=float), np.asarray(d.point, dtype=float)
+    start, goal = endpoint_cell(model, origin, "origin", o.where), endpoint_cell(model, destination, "destination", d.where)
     cell = model.field.grid.cell
     stages: dict[str, TrackStage] = {}
     paths: dict[str, np.ndarray] = {}
+    warmup_s = warm_up(backend)  # compiling the search is not the shortest stage's time
     for name in ("shortest", "initial"):
         result = grid_search(model.search_problem(name), start, goal, backend=backend, heuristic=heuristic)
         paths[name] = result.path
@@ -316,4 +355,4 @@ def plan_track(model: PlanningModel, origin, destination, *, backend: str | None
         raise UamoptError(f"the track is {stages['optimal'].length_m:.0f} m long, beyond the range L_e = {limit:g} m (Eq. 17)",
                           "aircraft.range_m", "choose closer points or an aircraft with a longer range")
     return TrackPlan(tuple(map(float, origin)), tuple(map(float, destination)), stages,
-                     midpoint=TrackStage(**{**midpoint.__dict__, "seconds": t_mid}))
+                     midpoint=TrackStage(**{**midpoint.__dict__, "seconds": t_mid}), warmup_seconds=warmup_s)

@@ -1,14 +1,14 @@
 """Flights and flight sets: the input of the scheduling model (Sec. 4.3), and ``flights.json``.
 
 A :class:`Flight` is one planned flight of one aircraft along one track, flown at constant speed
-``v_g`` with no en-route holding (MODEL_NOTES). A :class:`FlightSet` is every flight of a day with
+``v_g`` with no en-route holding (docs/readings.md). A :class:`FlightSet` is every flight of a day with
 the rules that tie them: the service window [T_s, T_f] (Eq. 26) and the turnaround gaps of
 Eqs. 27-28. Per aircraft, flights are ordered by planned departure; the f-th flight (1-based) of an
 aircraft is an outbound when f is odd and a return when f is even, and the gap after it is
 T_D (odd f) or T_R (even f). That gap is stored explicitly per flight (``turnaround_after_s``)
 so solvers need no parity logic.
 
-``flights.json`` (INTERFACES.md)::
+``flights.json`` (docs/interfaces.md)::
 
     {"cell": [dx, dy, dz], "conflict_radius": r,
      "service_start_s": 0, "service_end_s": 3600, "outbound_gap_s": 240, "return_gap_s": 360,
@@ -121,6 +121,7 @@ class FlightSet:
     service_end_s: float = DEFAULT_SERVICE_S  # T_f, s (Eqs. 23, 26)
     outbound_gap_s: float = 240.0  # T_D, s (Eq. 28)
     return_gap_s: float = 360.0  # T_R, s (Eq. 28)
+    notes: tuple[str, ...] = ()  # how the generator adapted the plan (written to summary.json)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "cell", tuple(float(c) for c in self.cell))
@@ -134,6 +135,20 @@ class FlightSet:
 
     def __len__(self) -> int:
         return len(self.flights)
+
+    def to_frame(self):
+        """One row per flight: aircraft, route, origin, destination, speed_mps,
+        planned_departure_s, planned_arrival_s, max_delay_s, turnaround_after_s, length_m,
+        n_waypoints (pandas DataFrame indexed by flight id)."""
+        import pandas as pd
+
+        arrival = self.planned_arrival_s
+        rows = [{"flight": f.id, "aircraft": f.aircraft, "route": f.route, "origin": f.origin,
+                 "destination": f.destination, "speed_mps": f.speed_mps, "planned_departure_s": f.planned_departure_s,
+                 "planned_arrival_s": float(arrival[i]), "max_delay_s": f.max_delay_s,
+                 "turnaround_after_s": f.turnaround_after_s, "length_m": f.length_m,
+                 "n_waypoints": len(f.waypoints)} for i, f in enumerate(self.flights)]
+        return pd.DataFrame(rows).set_index("flight")
 
     # --- per-aircraft chains ------------------------------------------------------------
     @cached_property
@@ -174,7 +189,7 @@ class FlightSet:
     def requires(self) -> np.ndarray:
         """For a return (even leg): the index of its outbound, which it needs operated; else −1.
 
-        A cancelled outbound cancels its return: the aircraft never left (MODEL_NOTES).
+        A cancelled outbound cancels its return: the aircraft never left (docs/readings.md).
         """
         return _frozen(np.where(self.leg % 2 == 0, self.previous, -1))
 
@@ -329,7 +344,7 @@ def load_flights(
     grid: AirspaceGrid | None = None,
     network: Mapping[str, np.ndarray] | None = None,
 ) -> FlightSet:
-    """Read and validate ``flights.json`` (INTERFACES.md).
+    """Read and validate ``flights.json`` (docs/interfaces.md).
 
     Parameters
     ----------

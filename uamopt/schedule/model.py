@@ -5,7 +5,7 @@ paper: per flight its planned departure D, flight time, delay bound, turnaround 
 predecessors; per conflicting pair the forbidden open intervals of δ = dep_q − dep_p; the
 objective. Decisions: c_f ∈ {0, 1} (operated) and 0 ≤ d_f ≤ ``delay_upper_s[f]``; dep_f = D_f + d_f.
 
-Constraints (MODEL_NOTES, Scheduling):
+Constraints (docs/readings.md, Scheduling):
 
 1. Conflicts: for each pair (p, q, intervals) of ``conflicts`` with c_p = c_q = 1,
    dep_q − dep_p ∉ (lo, hi) for every row — i.e. δ ≤ lo or δ ≥ hi.
@@ -40,8 +40,8 @@ from uamopt.schedule.occupancy import ConflictTable, conflict_table
 if TYPE_CHECKING:
     from uamopt.scenario import Scenario
 
-Status = Literal["optimal", "feasible", "time_limit", "infeasible"]
-STATUSES = ("optimal", "feasible", "time_limit", "infeasible")
+Status = Literal["optimal", "feasible", "time_limit", "infeasible", "error"]
+STATUSES = ("optimal", "feasible", "time_limit", "infeasible", "error")
 ObjectiveKind = Literal["weighted", "lexicographic"]
 
 
@@ -54,6 +54,7 @@ class SchedulingProblem:
     weights: tuple[float, float] = (0.6, 0.4)  # (ω6, ω7), Eq. 20
     aircraft_count: int = 0  # G, Eq. 21: the number of distinct aircraft in ``flights`` (0: fill it in)
     objective_kind: ObjectiveKind = "weighted"
+    time_step_s: float = 10.0  # ΔT_a (Table B.3): the heuristics' delay grid unless a profile sets step_s
 
     def __post_init__(self) -> None:
         if self.objective_kind not in ("weighted", "lexicographic"):
@@ -115,13 +116,14 @@ def build_problem(
     """Compute the pair conflicts of ``flightset`` and assemble the model.
 
     ``weights`` default to the scenario's (ω6, ω7) = (0.6, 0.4); G defaults to the number of
-    distinct aircraft in the flight set (INTERFACES.md).
+    distinct aircraft in the flight set (docs/interfaces.md); ΔT_a is ``schedule.time_step_s``.
     """
     if weights is None:
         weights = tuple(scenario.schedule.weights) if scenario is not None else (0.6, 0.4)  # type: ignore[assignment]
     return SchedulingProblem(
         flights=flightset, conflicts=conflict_table(flightset), weights=tuple(float(w) for w in weights),  # type: ignore[arg-type]
         aircraft_count=flightset.n_aircraft, objective_kind=objective,
+        time_step_s=float(scenario.schedule.time_step_s) if scenario is not None else 10.0,
     )
 
 
@@ -185,6 +187,7 @@ class Schedule:
     seed: int | None = None
     aircraft_count: int = 1  # G, for Eq. 21
     extras: dict = field(default_factory=dict)  # solver-specific figures (iterations, nodes, ...)
+    flight_ids: tuple[str, ...] = ()  # row i of operated/delay_s is flight flight_ids[i]
 
     def __post_init__(self) -> None:
         if self.status not in STATUSES:
@@ -208,9 +211,19 @@ class Schedule:
         """T_d = total delay of operated flights / G (Eq. 21)."""
         return self.total_delay_s / self.aircraft_count
 
+    def to_frame(self):
+        """One row per flight: operated, delay_s (pandas DataFrame indexed by flight id; the
+        problem's planned times are in ``FlightSet.to_frame()``, join on the index)."""
+        import pandas as pd
+
+        ids = list(self.flight_ids) or [str(i) for i in range(len(self.operated))]
+        frame = pd.DataFrame({"flight": ids, "operated": np.asarray(self.operated, dtype=bool),
+                              "delay_s": np.asarray(self.delay_s, dtype=float)})
+        return frame.set_index("flight")
+
     def summary(self) -> dict:
-        """The keys of summary.json (INTERFACES.md), plus ``model`` (what the status and bound are
-        about, e.g. a delay grid), ``continuous_bound`` (a bound valid for continuous delays) and
+        """The keys of summary.json (docs/interfaces.md), plus ``model`` (what the status and bound
+        are about, e.g. a delay grid), ``continuous_bound`` (a bound valid for continuous delays) and
         ``optimal_within`` (objective − continuous_bound) when the solver gives them."""
         named = {key: self.extras[key] for key in ("model", "continuous_bound", "continuous_bound_model", "optimal_within")
                  if key in self.extras}
@@ -234,20 +247,22 @@ def make_schedule(
     if objective is not None and bound is not None:
         gap = abs(objective - bound) / max(abs(objective), 1e-10)
     return Schedule(solver=solver, status=status, operated=c, delay_s=d, objective=objective, bound=bound, gap=gap,
-                    solve_seconds=solve_seconds, seed=seed, aircraft_count=problem.aircraft_count, extras=dict(extras or {}))
+                    solve_seconds=solve_seconds, seed=seed, aircraft_count=problem.aircraft_count, extras=dict(extras or {}),
+                    flight_ids=tuple(f.id for f in problem.flights.flights))
 
 
 def _fmt(value: float) -> str:
     return repr(float(value))
 
 
-def write_schedule(out_dir: str | Path, problem: SchedulingProblem, schedule: Schedule) -> None:
+def write_schedule(out_dir: str | Path, problem: SchedulingProblem, schedule: Schedule, *, extra: dict | None = None) -> None:
     """Write flights.json, schedule.csv and summary.json into ``out_dir``, all or nothing.
 
     ``schedule.csv``: flight, aircraft, route, operated (1/0), planned_departure_s, delay_s,
     departure_s, arrival_s; a cancelled flight has delay 0 and empty departure and arrival.
-    ``summary.json`` carries the INTERFACES.md keys plus ``weights``, ``objective_kind``,
-    ``aircraft`` (G) and ``flights`` so the verifier can recompute the objective.
+    ``summary.json`` carries the docs/interfaces.md keys plus ``weights``, ``objective_kind``,
+    ``aircraft`` (G) and ``flights`` so the verifier can recompute the objective; ``extra`` adds
+    keys (``uamopt schedule`` adds ``frame`` and ``scenario`` for the exports, uamopt.export.frame).
     """
     from uamopt.outputs import staged_output, write_json
 
@@ -257,7 +272,11 @@ def write_schedule(out_dir: str | Path, problem: SchedulingProblem, schedule: Sc
     summary = schedule.summary() | {
         "weights": list(problem.weights), "objective_kind": problem.objective_kind,
         "aircraft": problem.aircraft_count, "flights": problem.n_flights,
-    }
+    } | (extra or {})
+    if schedule.extras:
+        summary["extras"] = schedule.extras
+    if fs.notes:
+        summary["plan_notes"] = list(fs.notes)
     with staged_output(out_dir) as stage:
         save_flights(stage / "flights.json", fs)
         with open(stage / "schedule.csv", "w", newline="", encoding="utf-8") as fh:

@@ -3,7 +3,7 @@
 Occupancy
 ---------
 A flight flies its piecewise-linear track at constant speed v_g from its departure, with no
-holding (MODEL_NOTES). Its position is linear in time between consecutive *breakpoints*: the
+holding (docs/readings.md). Its position is linear in time between consecutive *breakpoints*: the
 waypoint times and the instants where the track crosses any x, y or z grid plane. Between two
 breakpoints it stays in one cell, found from the position at the middle of the interval. The
 breakpoints are computed for all segments and planes at once (numpy, no loop over cells).

@@ -16,7 +16,6 @@ import numpy as np
 
 from uamopt.errors import UamoptError
 from uamopt.schedule.flights import (
-    DEFAULT_SERVICE_S,
     Flight,
     FlightSet,
     check_flightset,
@@ -35,11 +34,8 @@ def route_name(origin: str, destination: str) -> str:
 
 
 def scenario_routes(scenario: Scenario) -> list[tuple[str, str]]:
-    """The network's routes (a, b): the scenario's list, or every pair in vertiport order."""
-    if scenario.network.routes is not None:
-        return [tuple(r) for r in scenario.network.routes]  # type: ignore[misc]
-    names = [v.name for v in scenario.network.vertiports]
-    return [(a, b) for i, a in enumerate(names) for b in names[i + 1:]]
+    """The network's routes (a, b) (:meth:`uamopt.scenario.NetworkConfig.route_list`)."""
+    return scenario.network.route_list()
 
 
 def straight_network(scenario: Scenario, grid: AirspaceGrid, *, layer_offset_cells: int = 1) -> dict[str, np.ndarray]:
@@ -92,23 +88,25 @@ def flights_per_aircraft(
 
 
 def grid_vertiports(n: int, extent_m: tuple[float, float], *, margin_m: float = 300.0, seed: int = 0) -> tuple[Vertiport, ...]:
-    """``n`` vertiports V1..Vn at seeded random whole-metre points of [margin, extent − margin]².
+    """``n`` vertiports V1..Vn at seeded random whole-metre points of [margin, extent − margin]², at
+    least 500 m apart (:func:`uamopt.scenario.random_vertiports`, the ``network.random_vertiports`` key)."""
+    from uamopt.scenario import random_vertiports
 
-    For benchmarks on larger domains; at least 500 m apart where the domain allows it.
+    try:
+        return random_vertiports(n, extent_m, margin_m=margin_m, seed=seed)
+    except ValueError as exc:
+        raise UamoptError(str(exc), f"extent {extent_m}", "enlarge the domain or place fewer vertiports") from None
+
+
+def flights_per_aircraft_list(total: int, n_aircraft: int) -> list[int]:
+    """F per aircraft when the plan holds ``total`` flights: ⌊total/G⌋ each, the remainder spread
+    one each over the first aircraft.
+
+    >>> flights_per_aircraft_list(125, 20)[:6], sum(flights_per_aircraft_list(125, 20))
+    ([7, 7, 7, 7, 7, 6], 125)
     """
-    from uamopt.scenario import Vertiport
-
-    rng = np.random.default_rng(seed)
-    pts: list[tuple[float, float]] = []
-    for _ in range(1000 * n):
-        if len(pts) == n:
-            break
-        p = tuple(float(np.round(rng.uniform(margin_m, e - margin_m))) for e in extent_m)
-        if all(math.dist(p, q) >= 500.0 for q in pts):
-            pts.append(p)  # type: ignore[arg-type]
-    if len(pts) < n:
-        raise UamoptError(f"cannot place {n} vertiports 500 m apart", f"extent {extent_m}", "enlarge the domain")
-    return tuple(Vertiport(name=f"V{i + 1}", x=x, y=y) for i, (x, y) in enumerate(pts))
+    base, extra = divmod(int(total), int(n_aircraft))
+    return [base + (1 if g < extra else 0) for g in range(n_aircraft)]
 
 
 def generate_plan(
@@ -117,92 +115,123 @@ def generate_plan(
     seed: int,
     *,
     aircraft: int | None = None,
-    service_s: float = DEFAULT_SERVICE_S,
+    flights: int | None = None,
+    service_s: float | None = None,
     service_start_s: float = 0.0,
-    first_departure_window_s: float = 600.0,
-    departure_step_s: float = 1.0,
-    flights_per_aircraft_override: int | None = None,
+    first_departure_window_s: float | None = None,
+    departure_step_s: float | None = None,
+    max_delay_scale: float | None = None,
     cell: tuple[float, float, float] | None = None,
 ) -> FlightSet:
-    """The initial flight plan: G aircraft on round trips, F flights each (Sec. 6.2, Eqs. 23-29).
+    """The initial flight plan: G aircraft on round trips (Sec. 6.2, Eqs. 23-29).
+
+    Every keyword defaults to the scenario's ``[schedule]`` key of the same meaning.
 
     Parameters
     ----------
     scenario : Scenario
         Supplies the routes, v_g (``aircraft.cruise_speed_mps``), T_D, T_R, χ, G, r and the cell.
-    network : mapping route name -> (n, 3) waypoints
-        Both directions of every route, named ``"a-b"`` (e.g. :func:`straight_network`).
+    network : RouteNetwork, or mapping route name -> (n, 3) waypoints
+        Both directions of every route, named ``"a-b"`` (:func:`~uamopt.planning.network.plan_network`
+        or :func:`straight_network`).
     seed : int
         Seeds the first departures.
     aircraft : int, optional
-        G; default ``schedule.aircraft`` (20). Aircraft k flies route k mod R, starting at the
-        route's first vertiport (20 aircraft over 10 routes: 2 per route).
+        G (``schedule.aircraft``). Aircraft k flies route k mod R, starting at the route's first
+        vertiport (20 aircraft over 10 routes: 2 per route).
+    flights : int, optional
+        Total planned flights (``schedule.flights``): ⌊flights/G⌋ per aircraft, the remainder one
+        each over the first aircraft. ``None``: F per aircraft from Eq. 23 with L_g = the longest
+        route of the network (Table B.3's 4365 m) and the scenario's speed and service window.
     service_s, service_start_s : float
-        T_f − T_s and T_s, s.
+        T_f − T_s (``schedule.service_s``) and T_s, s.
     first_departure_window_s : float
         Each aircraft's first planned departure is drawn uniformly from
-        T_s + {0, step, 2·step, ...} ≤ T_s + window (a calibration knob).
+        T_s + {0, step, 2·step, ...} ≤ T_s + window. Where an aircraft's chain leaves less slack
+        before T_f than the window, its window shrinks to the slack and a note says so
+        (``FlightSet.notes``, written to summary.json).
     departure_step_s : float
-        Resolution of that draw, s.
-    flights_per_aircraft_override : int, optional
-        F; default Eq. 23 with L_g = the longest route of the network (Table B.3's 4365 m).
+        Resolution of that draw, s (``schedule.time_step_s``, ΔT_a).
+    max_delay_scale : float
+        Δd_f = round(scale × (round(L/v_g) + ΔT)) (Eq. 29 as an inequality; ``schedule.max_delay_scale``).
     cell : (Δx, Δy, Δz), optional
         Default ``grid.cell``.
 
     Each next planned departure is the previous planned arrival + ΔT (Eq. 27 with equality),
-    ΔT = T_D after an outbound, T_R after a return (Eq. 28); Δd = round(L/v_g) + ΔT with the
-    flight's own track length L (Eq. 29 with equality).
+    ΔT = T_D after an outbound, T_R after a return (Eq. 28).
 
     Raises
     ------
     UamoptError
-        A route missing from ``network``, or a window so wide that some flight would end after T_f.
+        A route missing from ``network``, a bad scale, or flights that cannot fit in the service
+        window even with no slack.
     """
+    if callable(getattr(network, "waypoints", None)):  # a RouteNetwork
+        network = network.waypoints()
     sched = scenario.schedule
     n_aircraft = sched.aircraft if aircraft is None else int(aircraft)
+    total = sched.flights if flights is None else int(flights)
+    service_s = sched.service_s if service_s is None else float(service_s)
+    window = sched.first_departure_window_s if first_departure_window_s is None else float(first_departure_window_s)
+    step = sched.time_step_s if departure_step_s is None else float(departure_step_s)
+    scale = sched.max_delay_scale if max_delay_scale is None else float(max_delay_scale)
+    if not 0.0 < scale <= 1.0:
+        raise UamoptError(f"max_delay_scale must be in (0, 1], got {scale}", "schedule.max_delay_scale",
+                          "Eq. 29 bounds Δd by round(L/v_g) + ΔT; give a fraction of that bound")
     speed = scenario.aircraft.cruise_speed_mps
     routes = scenario_routes(scenario)
     for a, b in routes:
         for name in (route_name(a, b), route_name(b, a)):
             if name not in network:
                 raise UamoptError(f"unknown route '{name}'", "network", f"give tracks for every route; known: {', '.join(network)}")
-    longest = max(track_length_m(t) for t in network.values())
-    n_flights = flights_per_aircraft_override or flights_per_aircraft(
-        service_s, longest, speed, sched.outbound_gap_s, sched.return_gap_s, sched.interference
-    )
-    if n_flights < 1:
-        raise UamoptError(f"the service window of {service_s:g} s holds no round trip (Eq. 23)", "generate_plan", "lengthen service_s")
+    if total is None:
+        longest = max(track_length_m(t) for t in network.values())
+        per_aircraft = [flights_per_aircraft(service_s, longest, speed, sched.outbound_gap_s, sched.return_gap_s,
+                                             sched.interference)] * n_aircraft
+        if per_aircraft[0] < 1:
+            raise UamoptError(f"the service window of {service_s:g} s holds no round trip (Eq. 23)",
+                              "schedule.service_s", "lengthen the service window or set schedule.flights")
+    else:
+        per_aircraft = flights_per_aircraft_list(total, n_aircraft)
     service_end = service_start_s + service_s
     rng = np.random.default_rng(seed)
     width = max(len(str(n_aircraft)), 2)
-    flights: list[Flight] = []
+    plan: list[Flight] = []
+    narrowed: list[float] = []
     for g in range(n_aircraft):
+        n_flights = per_aircraft[g]
         a, b = routes[g % len(routes)]
         legs = [(a, b) if f % 2 == 0 else (b, a) for f in range(n_flights)]
         times = [track_length_m(network[route_name(o, d)]) / speed for o, d in legs]
         gaps = [sched.outbound_gap_s if f % 2 == 0 else sched.return_gap_s for f in range(n_flights)]  # f is 0-based here
-        chain_s = sum(times) + sum(gaps[:-1])
-        slack = service_s - chain_s
-        if first_departure_window_s > slack + 1e-9:
+        slack = service_s - (sum(times) + sum(gaps[:-1]))
+        if slack < -1e-9:
             raise UamoptError(
-                f"first_departure_window_s = {first_departure_window_s:g} s lets aircraft {g + 1}'s {n_flights} flights "
-                f"end after the service end (slack {slack:.1f} s)",
-                "generate_plan", f"use a window ≤ {math.floor(slack)} s or fewer flights per aircraft",
-            )
-        steps = math.floor(first_departure_window_s / departure_step_s + 1e-9)
-        departure = service_start_s + departure_step_s * float(rng.integers(0, steps + 1))
+                f"aircraft {g + 1}'s {n_flights} flights need {service_s - slack:.0f} s, more than the "
+                f"{service_s:g} s service window", "schedule.flights / schedule.service_s",
+                "plan fewer flights, more aircraft (schedule.aircraft), a longer window or a faster aircraft")
+        width_g = window
+        if window > slack + 1e-9:
+            width_g = max(slack, 0.0)
+            narrowed.append(width_g)
+        steps = math.floor(width_g / step + 1e-9)
+        departure = service_start_s + step * float(rng.integers(0, steps + 1))
         aircraft_id = f"A{g + 1:0{width}d}"
-        for f, ((o, d), t, gap) in enumerate(zip(legs, times, gaps)):
-            flights.append(Flight(
-                id=f"F{len(flights) + 1:03d}", aircraft=aircraft_id, route=route_name(o, d), origin=o, destination=d,
-                speed_mps=speed, planned_departure_s=departure, max_delay_s=round_half_up(t) + gap,
+        for (o, d), t, gap in zip(legs, times, gaps):
+            plan.append(Flight(
+                id=f"F{len(plan) + 1:03d}", aircraft=aircraft_id, route=route_name(o, d), origin=o, destination=d,
+                speed_mps=speed, planned_departure_s=departure, max_delay_s=round_half_up(scale * (round_half_up(t) + gap)),
                 waypoints=network[route_name(o, d)], turnaround_after_s=gap,
             ))
             departure = departure + t + gap
+    notes = ()
+    if narrowed:
+        notes = (f"first_departure_window_s = {window:g} s does not fit {len(narrowed)} of {n_aircraft} aircraft; "
+                 f"their first departures were drawn from the slack they have (down to {min(narrowed):.0f} s)",)
     flightset = FlightSet(
         cell=tuple(cell) if cell is not None else tuple(scenario.grid.cell),  # type: ignore[arg-type]
-        conflict_radius=sched.conflict_radius, flights=tuple(flights), service_start_s=service_start_s,
-        service_end_s=service_end, outbound_gap_s=sched.outbound_gap_s, return_gap_s=sched.return_gap_s,
+        conflict_radius=sched.conflict_radius, flights=tuple(plan), service_start_s=service_start_s,
+        service_end_s=service_end, outbound_gap_s=sched.outbound_gap_s, return_gap_s=sched.return_gap_s, notes=notes,
     )
     check_flightset(flightset, None, "generate_plan")
     return flightset

@@ -1,7 +1,7 @@
 """The independent verifier behind ``uamopt verify DIR``.
 
 It reads ``DIR/flights.json`` and ``DIR/schedule.csv`` (and ``DIR/summary.json`` when present)
-and checks the schedule against the rules of MODEL_NOTES, sharing no code with the model: its own
+and checks the schedule against the rules of docs/readings.md, sharing no code with the model: its own
 file reading (json, csv), its own occupancy by a different algorithm (a 3-D digital differential
 analyser that walks each segment cell by cell in plain Python, Amanatides & Woo 1987, instead of
 the model's vectorised sort of all plane-crossing times) and its own conflict search (a hash of
@@ -18,6 +18,11 @@ Rules checked (tolerance ``TOL_S`` = 1e-6 s on every time):
 - no two operated flights of different aircraft occupy cells within ``conflict_radius`` in every
   axis during overlapping times of more than ``TOL_S`` (touching is not a conflict);
 - summary.json's counts, delays and (when its weights are given) objective agree.
+
+The folder is untrusted input: a field out of its range (a negative or non-integer conflict
+radius, a cell that is not positive, waypoints that are not finite or lie outside the local
+frame, a speed outside 0.1–200 m/s, times beyond 10⁷ s, a summary that is not an object, text
+that is not UTF-8) is an ``InputFileError`` (exit 2), never a pass.
 
 Cell convention (shared by definition with the model, not by code): cell = floor(coordinate / Δ);
 when a segment starts exactly on a plane and moves down that axis it is in the lower cell; a
@@ -39,6 +44,10 @@ TOL_S = 1e-6  # s
 TIE_S = 1e-9  # crossings closer than this are simultaneous, s
 BUCKET_S = 30.0  # time bucket of the conflict hash, s
 BLOCK = 3  # cells per axis in a block of the conflict hash (≥ r)
+MAX_RADIUS = 10  # conflict zone of at most 21³ cells
+SPEED_RANGE_MPS = (0.1, 200.0)  # ground speeds a flight file may claim, m/s
+MAX_TIME_S = 1e7  # |planned departure| and delay bounds, s (about 116 days)
+MAX_COORD_M = 1e6  # waypoint coordinates of the local frame, m (1,000 km)
 COLUMNS = ["flight", "aircraft", "route", "operated", "planned_departure_s", "delay_s", "departure_s", "arrival_s"]
 
 
@@ -111,15 +120,22 @@ def _read_flights(path: Path) -> dict:
     if not path.is_file():
         raise InputFileError(f"missing {path.name}", str(path.parent), "give a folder written by uamopt schedule")
     try:
-        raw = json.loads(path.read_text(encoding="utf-8"))
+        raw = json.loads(path.read_text(encoding="utf-8-sig"))
         flights = raw["flights"]
-        cell = [float(c) for c in raw["cell"]]
-    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        cell = [_number(c, "cell", str(path)) for c in raw["cell"]]
+    except (json.JSONDecodeError, UnicodeDecodeError, RecursionError) as exc:
         raise InputFileError(f"malformed JSON: {exc}", str(path), "rewrite the file with uamopt schedule") from None
     except (KeyError, TypeError, ValueError):
         raise InputFileError("missing or malformed 'flights' or 'cell'", str(path), "rewrite the file with uamopt schedule") from None
+    if len(cell) != 3 or min(cell) <= 0 or not isinstance(flights, list):
+        raise InputFileError(f"cell must be three positive sizes in metres and flights a list, got cell {raw['cell']!r}",
+                             str(path), "rewrite the file with uamopt schedule")
+    radius = raw.get("conflict_radius", 1)
+    if isinstance(radius, bool) or not isinstance(radius, int) or not 0 <= radius <= MAX_RADIUS:
+        raise InputFileError(f"conflict_radius must be an integer in [0, {MAX_RADIUS}], got {radius!r}", str(path),
+                             "rewrite the file with uamopt schedule (the scenario's schedule.conflict_radius)")
     out = {
-        "cell": cell, "radius": int(raw.get("conflict_radius", 1)), "flights": [],
+        "cell": cell, "radius": radius, "flights": [],
         "service_end_s": _number(raw.get("service_end_s", 3600.0), "service_end_s", str(path)),
         "gaps": (_number(raw.get("outbound_gap_s", 240.0), "outbound_gap_s", str(path)),
                  _number(raw.get("return_gap_s", 360.0), "return_gap_s", str(path))),
@@ -138,8 +154,19 @@ def _read_flights(path: Path) -> dict:
             }
         except (KeyError, TypeError, ValueError) as exc:
             raise InputFileError(f"missing or malformed key {exc}", where, "rewrite the file with uamopt schedule") from None
-        if len(wps) < 2 or any(len(p) != 3 for p in wps) or rec["speed"] <= 0:
-            raise InputFileError("waypoints or speed invalid", where, "rewrite the file with uamopt schedule")
+        if len(wps) < 2 or any(len(p) != 3 for p in wps) or not all(math.isfinite(v) for p in wps for v in p):
+            raise InputFileError("waypoints must be at least two finite [x, y, z] points", where,
+                                 "rewrite the file with uamopt schedule")
+        if not SPEED_RANGE_MPS[0] <= rec["speed"] <= SPEED_RANGE_MPS[1]:
+            raise InputFileError(f"speed_mps {rec['speed']:g} outside the physical range "
+                                 f"[{SPEED_RANGE_MPS[0]:g}, {SPEED_RANGE_MPS[1]:g}] m/s", where,
+                                 "rewrite the file with uamopt schedule")
+        if abs(rec["planned"]) > MAX_TIME_S or not 0 <= rec["max_delay"] <= MAX_TIME_S:
+            raise InputFileError(f"planned_departure_s or max_delay_s beyond ±{MAX_TIME_S:g} s", where,
+                                 "rewrite the file with uamopt schedule")
+        if any(v < 0 for p in wps for v in p) or any(abs(v) > MAX_COORD_M for p in wps for v in p):
+            raise InputFileError(f"waypoints outside the local frame [0, {MAX_COORD_M:g}] m (below the ground datum "
+                                 "or west/south of the grid's origin)", where, "rewrite the file with uamopt schedule")
         rec["length"] = sum(math.dist(a, b) for a, b in itertools.pairwise(wps))
         out["flights"].append(rec)
     return out
@@ -149,7 +176,16 @@ def _read_schedule(path: Path) -> dict[str, dict]:
     if not path.is_file():
         raise InputFileError(f"missing {path.name}", str(path.parent), "give a folder written by uamopt schedule")
     rows: dict[str, dict] = {}
-    with open(path, newline="", encoding="utf-8") as fh:
+    try:
+        return _parse_schedule(path, rows)
+    except UnicodeDecodeError:
+        raise InputFileError("schedule.csv is not UTF-8 text", str(path), "save it as UTF-8 CSV") from None
+    except csv.Error as exc:
+        raise InputFileError(f"malformed CSV: {exc}", str(path), "rewrite it with uamopt schedule") from None
+
+
+def _parse_schedule(path: Path, rows: dict[str, dict]) -> dict[str, dict]:
+    with open(path, newline="", encoding="utf-8-sig") as fh:  # -sig: a spreadsheet's BOM is not a column name
         reader = csv.DictReader(fh)
         if reader.fieldnames is None or any(c not in reader.fieldnames for c in COLUMNS):
             raise InputFileError(f"schedule.csv needs the columns {','.join(COLUMNS)}", str(path), "rewrite it with uamopt schedule")
@@ -288,9 +324,11 @@ def verify_files(flights_path: Path, schedule_path: Path, summary_path: Path | N
 
 def _check_summary(path: Path, spec: dict, flown: list[dict], n_aircraft: int) -> list[str]:
     try:
-        summary = json.loads(path.read_text(encoding="utf-8"))
-    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        summary = json.loads(path.read_text(encoding="utf-8-sig"))
+    except (json.JSONDecodeError, UnicodeDecodeError, RecursionError) as exc:
         raise InputFileError(f"malformed JSON: {exc}", str(path), "rewrite it with uamopt schedule") from None
+    if not isinstance(summary, dict):
+        raise InputFileError("summary.json does not hold a JSON object", str(path), "rewrite it with uamopt schedule")
     out: list[str] = []
     total = sum(f["delay"] for f in flown)
     expect = {"operated": len(flown), "cancelled": len(spec["flights"]) - len(flown),
@@ -307,7 +345,7 @@ def _check_summary(path: Path, spec: dict, flown: list[dict], n_aircraft: int) -
         got = summary.get(key)
         if not isinstance(got, (int, float)) or not _close(float(got), float(value)):
             out.append(f"summary.json: {key} = {got!r}, the schedule gives {value:.6g}")
-    if summary.get("status") not in ("optimal", "feasible", "time_limit", "infeasible"):
+    if summary.get("status") not in ("optimal", "feasible", "time_limit", "infeasible", "error"):
         out.append(f"summary.json: unknown status {summary.get('status')!r}")
     return out
 

@@ -44,6 +44,7 @@ is checked between generations (status "time_limit" when it stopped the run, els
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from dataclasses import dataclass, fields
@@ -260,6 +261,8 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
     if profile.solver not in ("ga", "soa"):
         raise UamoptError(f"genetic.solve cannot run solver '{profile.solver}'", "uamopt.solvers.genetic", "use ga or soa")
     opts = GeneticOptions.from_options(profile.options, profile.solver)
+    if "step_s" not in profile.options:  # ΔT_a of the scenario (schedule.time_step_s)
+        opts = dataclasses.replace(opts, step_s=problem.time_step_s)
     start = time.perf_counter()
     deadline = start + profile.time_limit_s
     rng = np.random.default_rng(profile.seed)

@@ -11,7 +11,7 @@ Fig. 13) — it is delayed past the interval's end (Fig. 12). Delays are whole m
 ΔT_a (``step_s``, Table B.3: 10 s), so a delay is rounded *up* to the step; with ``exact_gaps``
 the flight goes exactly to the gap's end instead. When the delay needed exceeds the flight's
 threshold, min(Δd_f, T_f − A_f) (Eqs. 26, 29), the flight is cancelled; a cancelled outbound
-cancels its return (MODEL_NOTES: the aircraft never left). The result is feasible by construction.
+cancels its return (docs/readings.md: the aircraft never left). The result is feasible by construction.
 
 Decoder (shared with :mod:`uamopt.solvers.genetic`)
 ---------------------------------------------------
@@ -153,9 +153,10 @@ def decoder_for(problem: SchedulingProblem) -> Decoder:
     return decoder
 
 
-def decoder_options(options: dict, solver: str) -> tuple[float, bool]:
-    """``step_s`` and ``exact_gaps`` of a profile's options, validated (ΔT_a > 0)."""
-    step_s = float(options.get("step_s", DEFAULT_STEP_S))
+def decoder_options(options: dict, solver: str, default_step_s: float = DEFAULT_STEP_S) -> tuple[float, bool]:
+    """``step_s`` and ``exact_gaps`` of a profile's options, validated (ΔT_a > 0); ``step_s``
+    defaults to the problem's ΔT_a (``schedule.time_step_s``)."""
+    step_s = float(options.get("step_s", default_step_s))
     if not step_s > 0:
         raise UamoptError(f"step_s must be positive, got {step_s}", f"solver {solver}", "give ΔT_a in seconds, e.g. 10")
     return step_s, bool(options.get("exact_gaps", False))
@@ -168,9 +169,11 @@ def check_options(options: dict, known: set[str], solver: str) -> None:
         raise UamoptError(f"unknown option '{unknown[0]}'", f"solver {solver}", f"valid options are {', '.join(sorted(known))}")
 
 
-def greedy_decisions(problem: SchedulingProblem, step_s: float = DEFAULT_STEP_S, exact_gaps: bool = False
+def greedy_decisions(problem: SchedulingProblem, step_s: float | None = None, exact_gaps: bool = False
                      ) -> tuple[np.ndarray, np.ndarray]:
-    """Operated flags and delays (s) of the preliminary strategy (Sec. 5.2.1)."""
+    """Operated flags and delays (s) of the preliminary strategy (Sec. 5.2.1); ``step_s``
+    defaults to the problem's ΔT_a."""
+    step_s = problem.time_step_s if step_s is None else step_s
     operated, delay = decoder_for(problem).decode(problem, np.zeros(problem.n_flights, dtype=np.int64), step_s, exact_gaps)
     return operated[0], delay[0]
 
@@ -178,7 +181,7 @@ def greedy_decisions(problem: SchedulingProblem, step_s: float = DEFAULT_STEP_S,
 def solve(problem: SchedulingProblem, profile) -> Schedule:
     """The preliminary strategy as a solver: status "feasible", no bound."""
     check_options(profile.options, {"step_s", "exact_gaps"}, "greedy")
-    step_s, exact = decoder_options(profile.options, "greedy")
+    step_s, exact = decoder_options(profile.options, "greedy", problem.time_step_s)
     start = time.perf_counter()
     operated, delay = greedy_decisions(problem, step_s, exact)
     return make_schedule(problem, "greedy", "feasible", operated, delay, solve_seconds=time.perf_counter() - start,

@@ -13,7 +13,7 @@ Variables
     dep_f − dep_e ≥ T_e + ΔT_e when c_e = c_f = 1. With A = D_e + T_e + ΔT_e − D_f this is
     d_f − d_e ≥ A − M_f (1 − c_f) − M_e (1 − c_e), M_f = (A + U_e)⁺, M_e = A⁺: the smallest M that
     cut no point with a cancelled flight (its delay is 0); dropped when A + U_e ≤ 0 (never binds).
-(c) conflicts    (Eq. 24 via MODEL_NOTES' exact core): pair (p, q) must keep δ = dep_q − dep_p
+(c) conflicts    (Eq. 24 via the exact core of docs/readings.md): pair (p, q) must keep δ = dep_q − dep_p
     out of its open intervals (lo_k, hi_k). Within δ's reachable range R = [D_q − D_p − U_p,
     D_q − D_p + U_q] the admissible δ form closed gaps [g_j, h_j]; one binary y_j per gap,
     Σ_j y_j ≥ c_p + c_q − 1, and y_j = 1 ⇒ g_j ≤ δ ≤ h_j with M = g_j − min R and max R − h_j (the

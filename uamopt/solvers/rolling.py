@@ -46,13 +46,10 @@ the feasibility tolerance. Lexicographic: the same with −1 per flight and dist
 
 Options (``[options]`` of a profile): ``window_s`` (900), ``inner`` ("cpsat"), ``window_time_limit_s``
 (default ``time_limit_s`` / number of non-empty windows), ``time_unit_s`` (CP-SAT, 0.01),
-``step_s`` (greedy fallback ΔT_a, 10). Status: ``feasible``, or ``time_limit`` if some window's
-inner solve stopped at its limit without proof. Registry line (``SOLVERS`` in __init__.py)::
-
-    "rolling": "uamopt.solvers.rolling",
-
-Until registered, call the module directly with any valid profile:
-``rolling.solve(problem, SolverProfile("cpsat", time_limit_s=60, options={"inner": "cpsat"}))``.
+``step_s`` (greedy fallback ΔT_a; default the problem's ``schedule.time_step_s``). Status: ``feasible``, or
+``time_limit`` if some window's inner solve stopped at its limit without proof. Registered as
+``"rolling"`` (profile ``solvers/rolling.toml``): ``solve(problem, "rolling")``, or
+``solve(problem, SolverProfile("rolling", time_limit_s=60, options={"window_s": 600.0}))``.
 """
 
 from __future__ import annotations
@@ -151,7 +148,8 @@ def subproblem(problem: SchedulingProblem, free: np.ndarray, fixed: np.ndarray, 
                           ptr=np.concatenate([[0], np.cumsum(counts[keep])]).astype(np.int64),
                           intervals=c.intervals[row_keep])
     sub = SchedulingProblem(flights=sub_fs, conflicts=table, weights=problem.weights,
-                            aircraft_count=problem.aircraft_count, objective_kind=problem.objective_kind)
+                            aircraft_count=problem.aircraft_count, objective_kind=problem.objective_kind,
+                            time_step_s=problem.time_step_s)
     return sub, index, is_fixed[index]
 
 
@@ -228,7 +226,7 @@ def _options(profile) -> dict:
     if not (math.isfinite(window) and window > 0):
         raise UamoptError(f"window_s must be positive, got {window}", "solver rolling", "give a window in seconds, e.g. 900")
     return {"inner": inner, "window_s": window, "window_time_limit_s": o.get("window_time_limit_s"),
-            "time_unit_s": float(o.get("time_unit_s", 0.01)), "step_s": float(o.get("step_s", 10.0))}
+            "time_unit_s": float(o.get("time_unit_s", 0.01)), "step_s": o.get("step_s")}
 
 
 def solve(problem: SchedulingProblem, profile) -> Schedule:
@@ -273,7 +271,7 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
         fixed = fixed[fixed >= 0].astype(np.int64)
         sub, index, fixed_mask = subproblem(problem, free, fixed, dep0 + delay)
         stats["max_subproblem"] = max(stats["max_subproblem"], sub.n_flights)
-        hint = _greedy_fixed_first(sub, fixed_mask, o["step_s"])
+        hint = _greedy_fixed_first(sub, fixed_mask, float(o["step_s"] or problem.time_step_s))
         answer = None
         try:
             if o["inner"] == "cpsat":
@@ -305,7 +303,7 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
     bad = violations(problem, operated, delay)
     if bad:  # cannot happen by construction; never return an infeasible schedule
         stats["fallback"] = f"whole-problem greedy ({len(bad)} violations, first: {bad[0]})"
-        operated, delay = greedy_decisions(problem, o["step_s"])
+        operated, delay = greedy_decisions(problem, o["step_s"] and float(o["step_s"]))
     bound = pair_matching_bound(problem)
     status = "time_limit" if stats["unproved"] else "feasible"
     stats["bound_of"] = "pair-matching relaxation (rolling.py docstring)"

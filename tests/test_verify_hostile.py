@@ -1,0 +1,98 @@
+"""The verifier trusts nothing it verifies: tampered schedule folders are one `error:` line and
+exit 2 (malformed) or a violation and exit 1, never a pass."""
+
+from __future__ import annotations
+
+import json
+import shutil
+
+import pytest
+
+from conftest import PAPER_CASE
+from uamopt.cli import main
+
+
+@pytest.fixture(scope="module")
+def good(tmp_path_factory):
+    out = tmp_path_factory.mktemp("good") / "s"
+    assert main(["schedule", str(PAPER_CASE), "--solver", "greedy", "--set", "tracks.layering='none'",
+                 "--out", str(out)]) == 0
+    return out
+
+
+def tampered(good, tmp_path, edit):
+    folder = tmp_path / "t"
+    shutil.copytree(good, folder)
+    doc = json.loads((folder / "flights.json").read_text())
+    edit(doc)
+    (folder / "flights.json").write_text(json.dumps(doc))
+    return folder
+
+
+def _set(key, value):
+    return lambda d: d.__setitem__(key, value)
+
+
+def _first(key, value):
+    return lambda d: d["flights"][0].__setitem__(key, value)
+
+
+@pytest.mark.parametrize("edit, fragment", [
+    (_set("conflict_radius", -1), "conflict_radius must be an integer"),
+    (_set("conflict_radius", "abc"), "conflict_radius must be an integer"),
+    (_set("conflict_radius", True), "conflict_radius must be an integer"),
+    (_set("conflict_radius", 1.5), "conflict_radius must be an integer"),
+    (_set("cell", [-50, 50, 30]), "cell must be three positive"),
+    (_set("cell", [0, 50, 30]), "cell must be three positive"),
+    (_set("flights", {"a": 1}), "flights a list"),
+    (_first("speed_mps", 1e-300), "physical range"),
+    (_first("waypoints", [[0, 0, "nan"], [10, 10, 120]]), "finite"),
+    (_first("waypoints", [[300, 300, -100], [2220, 4220, -100]]), "outside the local frame"),
+    (_first("waypoints", [[300, 300, 120], [2e9, 4220, 120]]), "outside the local frame"),
+    (_first("planned_departure_s", 1e300), "beyond"),
+])
+def test_malformed_flights_are_exit_2(good, tmp_path, capsys, edit, fragment):
+    folder = tampered(good, tmp_path, edit)
+    assert main(["verify", str(folder)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: ") and err.count("\n") == 1 and fragment in err
+
+
+def test_summary_list_and_non_utf8_csv(good, tmp_path, capsys):
+    folder = tmp_path / "s"
+    shutil.copytree(good, folder)
+    (folder / "summary.json").write_text("[1, 2, 3]")
+    assert main(["verify", str(folder)]) == 2 and "JSON object" in capsys.readouterr().err
+    shutil.copy(good / "summary.json", folder / "summary.json")
+    (folder / "schedule.csv").write_bytes((good / "schedule.csv").read_bytes().replace(b"F001", b"F\xff01"))
+    assert main(["verify", str(folder)]) == 2 and "not UTF-8" in capsys.readouterr().err
+
+
+def test_spreadsheet_bom_is_accepted(good, tmp_path, capsys):
+    folder = tmp_path / "s"
+    shutil.copytree(good, folder)
+    (folder / "schedule.csv").write_bytes(b"\xef\xbb\xbf" + (good / "schedule.csv").read_bytes())
+    assert main(["verify", str(folder)]) == 0
+
+
+def test_conflicting_folder_is_exit_1(good, tmp_path, capsys):
+    """Every flight operated at its planned time: the plan's own conflicts come back, exit 1."""
+    import csv
+
+    folder = tmp_path / "s"
+    shutil.copytree(good, folder)
+    doc = json.loads((folder / "flights.json").read_text())
+    rows = list(csv.DictReader(open(folder / "schedule.csv", newline="")))
+    by_id = {f["id"]: f for f in doc["flights"]}
+    for r in rows:  # all operated, no delay: the plan's own conflicts come back
+        f = by_id[r["flight"]]
+        length = sum(sum((a - b) ** 2 for a, b in zip(p, q)) ** 0.5 for p, q in zip(f["waypoints"], f["waypoints"][1:]))
+        r.update(operated="1", delay_s="0.0", departure_s=repr(f["planned_departure_s"]),
+                 arrival_s=repr(f["planned_departure_s"] + length / f["speed_mps"]))
+    with open(folder / "schedule.csv", "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=list(rows[0]))
+        w.writeheader()
+        w.writerows(rows)
+    (folder / "summary.json").unlink()
+    assert main(["verify", str(folder)]) == 1
+    assert "conflict: flights" in capsys.readouterr().out

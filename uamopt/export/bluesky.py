@@ -1,0 +1,193 @@
+"""``uamopt export bluesky DIR``: a schedule folder as a BlueSky scenario (``DIR/bluesky.scn``).
+
+BlueSky (TU Delft, PyPI ``bluesky-simulator``) replays the schedule with its own aircraft
+dynamics and its own loss-of-separation detection (:mod:`uamopt.sim.replay`). Every operated flight
+becomes one aircraft, created at its scheduled departure at the first point of its track, flying
+the track's waypoints at v_g and deleted when it passes the last one. Writing needs no BlueSky.
+
+Faithful to the plan, within what the simulator can do (measured figures in docs/export.md):
+
+- Positions are WGS 84 through the folder's :class:`~uamopt.export.frame.LocalFrame`; altitudes
+  are z (above the ground datum), in feet; speeds are CAS in knots (``CASMACHTHR 0`` first, so low
+  speeds are not read as Mach), converted from the true airspeed by the ISA (no wind: TAS = ground
+  speed).
+- BlueSky moves aircraft over a sphere of radius 6 371 km while the frame's metres are the CRS's:
+  the commanded speed of each leg is v_g × (spherical length / planned length), so that every leg
+  takes its planned time (a ±0.3 % correction; without it the drift reaches ~10 m over 4 km).
+- BlueSky steps its clock by ``dt``: an aircraft is created at the first step t_k ≥ departure, at
+  the point of its track the plan reaches at t_k (so the step does not delay it).
+- The aircraft type is EC35 (a helicopter that hovers, ≤ 72 m/s, ±7.6 m/s vertical) standing in
+  for the eVTOL, with bank limit ``bank_deg`` (default 45°: turn radius v²/(g tan φ) = 64 m at
+  25 m/s; BlueSky's 25° gives 137 m and cuts corners by up to ~60 m on our tracks). Waypoints are
+  fly-by, VNAV with top-of-climb/descent logic off, so climbs follow the planned gradient.
+- Detection: ``CDMETHOD STATEBASED``, resolution off, protected zone (``ZONER``, ``ZONEDH``) from
+  the replay's zone (see :func:`uamopt.sim.zone.protected_zone`).
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+
+from uamopt.export.folder import ScheduleFolder, read_schedule_folder, write_text_atomic
+
+FT_M = 0.3048
+KT_MPS = 1852.0 / 3600.0
+NM_M = 1852.0
+R_EARTH_BLUESKY_M = 6371000.0  # bluesky.tools.aero.Rearth: the sphere aircraft move on
+AIRCRAFT_TYPE = "EC35"
+DEFAULT_BANK_DEG = 45.0
+DEFAULT_DT_S = 0.05
+
+
+def tas_to_cas(tas_mps: np.ndarray, altitude_m: np.ndarray) -> np.ndarray:
+    """Calibrated airspeed of a true airspeed in the ISA troposphere (compressible), m/s.
+
+    p = p₀ (T/T₀)^(−g₀/(L R)), q_c = p [(1 + (γ−1)/2 (V/a)²)^(γ/(γ−1)) − 1],
+    CAS = √(2 a₀²/(γ−1) [(q_c/p₀ + 1)^((γ−1)/γ) − 1]).
+    """
+    gamma, r_air, g0, lapse = 1.4, 287.05287, 9.80665, -0.0065
+    t0, p0 = 288.15, 101325.0
+    temp = t0 + lapse * np.asarray(altitude_m, float)
+    p = p0 * (temp / t0) ** (-g0 / (lapse * r_air))
+    a, a0 = np.sqrt(gamma * r_air * temp), math.sqrt(gamma * r_air * t0)
+    qc = p * ((1 + (gamma - 1) / 2 * (np.asarray(tas_mps, float) / a) ** 2) ** (gamma / (gamma - 1)) - 1)
+    return np.sqrt(2 * a0 * a0 / (gamma - 1) * ((qc / p0 + 1) ** ((gamma - 1) / gamma) - 1))
+
+
+def sphere_distance_m(lon1, lat1, lon2, lat2) -> np.ndarray:
+    """Great-circle distance on BlueSky's sphere (R = 6 371 km), m (haversine)."""
+    p1, p2 = np.radians(lat1), np.radians(lat2)
+    h = np.sin((p2 - p1) / 2) ** 2 + np.cos(p1) * np.cos(p2) * np.sin(np.radians(np.subtract(lon2, lon1)) / 2) ** 2
+    return 2 * R_EARTH_BLUESKY_M * np.arcsin(np.sqrt(h))
+
+
+def sphere_bearing_deg(lon1, lat1, lon2, lat2) -> float:
+    """Initial great-circle bearing from point 1 to point 2, degrees from north."""
+    p1, p2, dl = math.radians(lat1), math.radians(lat2), math.radians(lon2 - lon1)
+    y = math.sin(dl) * math.cos(p2)
+    x = math.cos(p1) * math.sin(p2) - math.sin(p1) * math.cos(p2) * math.cos(dl)
+    return math.degrees(math.atan2(y, x)) % 360.0
+
+
+def first_step_s(departure_s: float, dt_s: float) -> float:
+    """t_k: the first multiple of ``dt_s`` at or after the departure (BlueSky's clock is exact decimal)."""
+    return math.ceil(departure_s / dt_s - 1e-9) * dt_s
+
+
+def track_from(waypoints: np.ndarray, distance_m: float) -> np.ndarray:
+    """The rest of a track from ``distance_m`` along it: the point there, then the later waypoints."""
+    if distance_m <= 0.0:
+        return waypoints
+    seg = np.linalg.norm(np.diff(waypoints, axis=0), axis=1)
+    cum = np.concatenate([[0.0], np.cumsum(seg)])
+    k = min(int(np.searchsorted(cum, distance_m, side="right")) - 1, len(seg) - 1)
+    start = waypoints[k] + min(1.0, (distance_m - cum[k]) / seg[k]) * (waypoints[k + 1] - waypoints[k])
+    rest = waypoints[k + 1:]
+    if len(rest) > 1 and np.linalg.norm(rest[0] - start) < 1e-6:
+        rest = rest[1:]  # the step ends on a waypoint: do not repeat it
+    return np.vstack([start, rest])
+
+
+def aircraft_ids(flight_ids: Sequence[str]) -> dict[str, str]:
+    """BlueSky callsigns: the flight id in upper-case letters and digits, made unique."""
+    out: dict[str, str] = {}
+    used: set[str] = set()
+    for n, fid in enumerate(flight_ids):
+        base = re.sub(r"[^A-Z0-9]", "", fid.upper()) or f"F{n + 1}"
+        if base[0].isdigit():
+            base = "F" + base
+        acid, k = base, 1
+        while acid in used:
+            k += 1
+            acid = f"{base}X{k}"
+        used.add(acid)
+        out[fid] = acid
+    return out
+
+
+def _stamp(t_s: float) -> str:
+    h, rem = divmod(max(t_s, 0.0), 3600.0)
+    m, s = divmod(rem, 60.0)
+    return f"{int(h):02d}:{int(m):02d}:{s:06.3f}>"
+
+
+def flight_commands(acid: str, waypoints: np.ndarray, speed_mps: float, frame, bank_deg: float) -> list[str]:
+    """CRE, BANK, ADDWPT..., AT-last-waypoint DEL, LNAV/VNAV: one aircraft flying ``waypoints`` at v_g.
+
+    Repeated points (legs of zero length) are dropped: BlueSky would fly them at zero speed.
+    """
+    keep = np.concatenate([[True], np.linalg.norm(np.diff(waypoints, axis=0), axis=1) > 1e-6])
+    waypoints = waypoints[keep]
+    lon, lat = frame.to_lonlat(waypoints[:, 0], waypoints[:, 1])
+    z = waypoints[:, 2]
+    planned = np.linalg.norm(np.diff(waypoints, axis=0), axis=1)
+    ground = sphere_distance_m(lon[:-1], lat[:-1], lon[1:], lat[1:])
+    tas = speed_mps * ground / np.maximum(planned, 1e-9)  # leg time = planned length / v_g
+    cas_kt = tas_to_cas(tas, 0.5 * (z[:-1] + z[1:])) / KT_MPS
+    cas_kt = np.append(cas_kt, cas_kt[-1])  # VNAV speeds are "from" speeds: waypoint i sets leg i
+    alt_ft = np.maximum(z / FT_M, 0.1)  # ADDWPT ignores an altitude of exactly 0
+    hdg = sphere_bearing_deg(lon[0], lat[0], lon[1], lat[1])
+    end = f"{acid}_END"
+    lines = [f"CRE {acid} {AIRCRAFT_TYPE} {lat[0]:.8f} {lon[0]:.8f} {hdg:.3f} {alt_ft[0]:.2f} {cas_kt[0]:.4f}",
+             f"BANK {acid} {bank_deg:g}"]
+    lines += [f"ADDWPT {acid} {lat[i]:.8f} {lon[i]:.8f} {alt_ft[i]:.2f} {cas_kt[i]:.4f}" for i in range(1, len(z) - 1)]
+    lines += [f"DEFWPT {end} {lat[-1]:.8f} {lon[-1]:.8f}", f"ADDWPT {acid} {end} {alt_ft[-1]:.2f} {cas_kt[-1]:.4f}",
+              f"{acid} AT {end} DO DEL {acid}",
+              f"LNAV {acid} ON", f"SPD {acid} {cas_kt[0]:.4f}", f"SWTOC {acid} OFF", f"SWTOD {acid} OFF", f"VNAV {acid} ON"]
+    return lines
+
+
+def scenario_text(folder: ScheduleFolder, zone_m: tuple[float, float], *, dt_s: float = DEFAULT_DT_S,
+                  bank_deg: float = DEFAULT_BANK_DEG, flights: Sequence | None = None) -> str:
+    """The .scn text of the operated flights (or of ``flights``, a subset of ``folder.operated``).
+
+    ``zone_m`` = (r_pz, h_pz): BlueSky's protected zone, horizontal radius and half height, m.
+    """
+    frame = folder.frame
+    chosen = folder.operated if flights is None else tuple(flights)
+    ids = aircraft_ids([o.flight.id for o in folder.operated])
+    rpz, hpz = zone_m
+    lon0, lat0 = frame.to_lonlat(0.0, 0.0)
+    head = [
+        f"# uamopt schedule {folder.path.name}: {len(chosen)} operated flights replayed in BlueSky 1.1.1",
+        (f"# frame ({frame.source}{'' if folder.frame_recorded else ': none recorded, synthetic anchor assumed'}): "
+         f"local (0, 0) = lon {float(lon0):.7f}, lat {float(lat0):.7f}; CRS {frame.crs}"),
+        f"# protected zone: r_pz = {rpz:.2f} m, h_pz = {hpz:.2f} m; clock step DT = {dt_s:g} s (creation times assume it)",
+        "# aircraft: flight id -> callsign " + ", ".join(f"{o.flight.id}={ids[o.flight.id]}" for o in chosen),
+    ]
+    setup = ["CASMACHTHR 0", f"DT {dt_s:g}", "CDMETHOD STATEBASED", "RESO OFF",
+             f"ZONER {rpz / NM_M:.6f}", f"ZONEDH {hpz / FT_M:.4f}", f"PAN {float(lat0):.6f} {float(lon0):.6f}"]
+    lines = [_stamp(0.0) + c for c in setup]
+    for o in chosen:
+        t_k = first_step_s(o.departure_s, dt_s)
+        track = track_from(np.asarray(o.flight.waypoints, float), o.flight.speed_mps * (t_k - o.departure_s))
+        stamp = _stamp(t_k - dt_s / 2)  # executes at the step whose clock reads t_k
+        lines += [stamp + c for c in flight_commands(ids[o.flight.id], track, o.flight.speed_mps, frame, bank_deg)]
+    return "\n".join(head + lines) + "\n"
+
+
+def export_bluesky(path: str | Path, zone_m: tuple[float, float] | None = None, *, dt_s: float = DEFAULT_DT_S,
+                   bank_deg: float = DEFAULT_BANK_DEG) -> Path:
+    """Write ``DIR/bluesky.scn`` for the schedule folder ``path``; returns the file's path.
+
+    ``zone_m`` defaults to :func:`uamopt.sim.zone.protected_zone` of the folder's cell and r.
+
+    Raises
+    ------
+    InputFileError
+        The folder or one of its files is missing or malformed.
+    """
+    from uamopt.sim.zone import protected_zone
+
+    folder = read_schedule_folder(path)
+    if zone_m is None:
+        zone = protected_zone(folder.flights.cell, folder.flights.conflict_radius)
+        zone_m = (zone.rpz_m, zone.hpz_m)
+    target = folder.path / "bluesky.scn"
+    write_text_atomic(target, scenario_text(folder, zone_m, dt_s=dt_s, bank_deg=bank_deg))
+    return target

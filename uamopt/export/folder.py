@@ -1,0 +1,142 @@
+"""Reading a schedule folder (``flights.json``, ``schedule.csv``, ``summary.json``) for the exports.
+
+The folder is what ``uamopt schedule`` writes (docs/interfaces.md). The exports need the operated
+flights with their departure and arrival times, the tracks, and the georeference (``frame`` in
+summary.json, see :mod:`uamopt.export.frame`).
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+import os
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+
+from uamopt.errors import InputFileError
+from uamopt.export.frame import LocalFrame, synthetic_frame
+from uamopt.schedule.flights import Flight, FlightSet, load_flights
+
+
+@dataclass(frozen=True)
+class OperatedFlight:
+    """One operated flight of a schedule: its plan and its scheduled times (s)."""
+
+    flight: Flight
+    departure_s: float
+    arrival_s: float
+
+
+@dataclass(frozen=True)
+class ScheduleFolder:
+    """A schedule folder's content, as the exports read it.
+
+    ``frame_recorded`` is False for a folder written before summary.json carried ``frame``: its
+    frame is then the synthetic anchor (``source = "default"``). ``scenario`` is the recorded
+    ``{"name", "file", "set"}`` or None.
+    """
+
+    path: Path
+    flights: FlightSet
+    operated: tuple[OperatedFlight, ...]
+    frame: LocalFrame
+    frame_recorded: bool
+    scenario: dict | None
+    summary: dict
+
+
+def _number(text: str, what: str, where: str) -> float:
+    try:
+        value = float(text)
+    except (TypeError, ValueError):
+        value = math.nan
+    if not math.isfinite(value):
+        raise InputFileError(f"{what} is not a finite number: {text!r}", where, "rewrite the folder with uamopt schedule")
+    return value
+
+
+def _operated(path: Path, flights: FlightSet) -> tuple[OperatedFlight, ...]:
+    if not path.is_file():
+        raise InputFileError(f"missing {path.name}", str(path.parent), "give a folder written by uamopt schedule")
+    by_id = {f.id: f for f in flights.flights}
+    out = []
+    with open(path, newline="", encoding="utf-8") as fh:
+        reader = csv.DictReader(fh)
+        need = ("flight", "operated", "departure_s", "arrival_s")
+        if reader.fieldnames is None or any(c not in reader.fieldnames for c in need):
+            raise InputFileError(f"schedule.csv needs the columns {', '.join(need)}", str(path), "rewrite it with uamopt schedule")
+        for n, row in enumerate(reader, start=2):
+            where = f"{path}: line {n}"
+            if row["operated"].strip().lower() not in ("1", "true"):
+                continue
+            flight = by_id.get(row["flight"])
+            if flight is None:
+                raise InputFileError(f"flight {row['flight']!r} is not in flights.json", where, "rewrite the folder with uamopt schedule")
+            out.append(OperatedFlight(flight, _number(row["departure_s"], "departure_s", where),
+                                      _number(row["arrival_s"], "arrival_s", where)))
+    return tuple(sorted(out, key=lambda o: (o.departure_s, o.flight.id)))
+
+
+def read_schedule_folder(path: str | Path) -> ScheduleFolder:
+    """Read a schedule folder written by ``uamopt schedule``.
+
+    Raises
+    ------
+    InputFileError
+        The folder or one of its files is missing or malformed.
+    """
+    folder = Path(path)
+    if not folder.is_dir():
+        raise InputFileError(f"not a folder: {folder}", str(folder), "give the --out folder of uamopt schedule")
+    flights = load_flights(folder / "flights.json")
+    summary: dict = {}
+    summary_path = folder / "summary.json"
+    if summary_path.is_file():
+        try:
+            summary = json.loads(summary_path.read_text(encoding="utf-8"))
+        except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+            raise InputFileError(f"malformed JSON: {exc}", str(summary_path), "rewrite it with uamopt schedule") from None
+    raw_frame = summary.get("frame") if isinstance(summary, dict) else None
+    frame = LocalFrame.from_dict(raw_frame, str(summary_path)) if isinstance(raw_frame, dict) else synthetic_frame("default")
+    scenario = summary.get("scenario") if isinstance(summary.get("scenario"), dict) else None
+    return ScheduleFolder(folder, flights, _operated(folder / "schedule.csv", flights), frame,
+                          isinstance(raw_frame, dict), scenario, summary)
+
+
+def recorded_scenario(folder: ScheduleFolder, scenario_path: str | None = None, overrides: list[str] | None = None):
+    """The scenario the folder was scheduled with: ``scenario_path`` if given, else the recorded file.
+
+    Raises
+    ------
+    InputFileError
+        No scenario given and none recorded (a folder from before the record existed).
+    ScenarioError
+        The scenario file is missing or malformed.
+    """
+    from uamopt.scenario import load_scenario
+
+    if scenario_path is not None:
+        return load_scenario(scenario_path, overrides or [])
+    record = folder.scenario or {}
+    if not record.get("file"):
+        raise InputFileError("the folder records no scenario file", str(folder.path / "summary.json"),
+                             "pass --scenario FILE (and its --set overrides), or --risk risk.npz")
+    return load_scenario(record["file"], list(record.get("set", [])) + list(overrides or []))
+
+
+def write_text_atomic(path: Path, text: str) -> None:
+    """Write ``text`` to ``path`` through a temporary file and a rename: never half-written."""
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as fh:
+            fh.write(text)
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)  # as an ordinary open() would create it
+        os.replace(tmp, path)
+    except OSError as exc:
+        Path(tmp).unlink(missing_ok=True)
+        raise InputFileError(f"cannot write {path.name}: {exc.strerror or exc}", str(path.parent),
+                             "check the folder's permissions") from None

@@ -1,0 +1,153 @@
+"""``uamopt export geojson DIR``: tracks, vertiports and unsafe airspace for GIS tools.
+
+Writes three RFC 7946 files into the schedule folder DIR, in WGS 84 (longitude, latitude[, z]),
+through the folder's :class:`~uamopt.export.frame.LocalFrame`; QGIS, kepler.gl and GeoPandas
+read them as they are:
+
+- ``tracks.geojson``: one LineString per flight with z (m above the ground datum) at every
+  waypoint; properties id, aircraft, route, origin, destination, operated, departure_s,
+  arrival_s (null when cancelled), speed_mps, length_m.
+- ``vertiports.geojson``: one Point per vertiport named in the flights (a track's first point is
+  its origin, its last point its destination).
+- ``unsafe.geojson``: one (Multi)Polygon per altitude layer, the union of that layer's unsafe
+  cells (Eq. 9: risk above R_0, obstacle or no-fly); properties layer, z_bottom_m, z_top_m,
+  z_centre_m, in_band (Eq. 14; null when read from a risk.npz), unsafe_cells, obstacle_cells.
+
+The unsafe airspace needs the risk field. By default it is recomputed from the scenario the folder
+records (summary.json ``scenario``: file and overrides); ``risk=`` takes a ``risk.npz`` written by
+``uamopt risk`` instead, and ``scenario=`` names the scenario file when the folder records none.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import shapely
+import shapely.geometry
+from shapely.geometry.polygon import orient
+
+from uamopt.errors import InputFileError
+from uamopt.export.folder import (
+    ScheduleFolder,
+    read_schedule_folder,
+    recorded_scenario,
+    write_text_atomic,
+)
+
+DEGREE_DIGITS = 7  # ~1 cm
+METRE_DIGITS = 2
+
+
+def _collection(features: list[dict], folder: ScheduleFolder, what: str) -> str:
+    doc = {"type": "FeatureCollection", "name": what, "features": features,
+           "uamopt": {"folder": folder.path.name, "frame": folder.frame.as_dict(), "frame_recorded": folder.frame_recorded}}
+    return json.dumps(doc, separators=(",", ":")) + "\n"
+
+
+def _lonlat(frame, xy: np.ndarray) -> np.ndarray:
+    lon, lat = frame.to_lonlat(xy[:, 0], xy[:, 1])
+    return np.column_stack([np.round(lon, DEGREE_DIGITS), np.round(lat, DEGREE_DIGITS)])
+
+
+def track_features(folder: ScheduleFolder) -> list[dict]:
+    """One LineString Z feature per flight of the folder."""
+    times = {o.flight.id: o for o in folder.operated}
+    out = []
+    for f in folder.flights.flights:
+        wp = np.asarray(f.waypoints, float)
+        coords = np.column_stack([_lonlat(folder.frame, wp), np.round(wp[:, 2], METRE_DIGITS)])
+        o = times.get(f.id)
+        out.append({"type": "Feature", "geometry": {"type": "LineString", "coordinates": coords.tolist()},
+                    "properties": {"id": f.id, "aircraft": f.aircraft, "route": f.route, "origin": f.origin,
+                                   "destination": f.destination, "operated": o is not None,
+                                   "departure_s": o.departure_s if o else None, "arrival_s": o.arrival_s if o else None,
+                                   "speed_mps": f.speed_mps, "length_m": round(f.length_m, METRE_DIGITS)}})
+    return out
+
+
+def vertiport_features(folder: ScheduleFolder) -> list[dict]:
+    """One Point per vertiport label: a track's first point (origin) or last point (destination)."""
+    places: dict[str, np.ndarray] = {}
+    for f in folder.flights.flights:
+        places.setdefault(f.origin, np.asarray(f.waypoints[0], float))
+        places.setdefault(f.destination, np.asarray(f.waypoints[-1], float))
+    out = []
+    for name, p in places.items():
+        lon, lat = _lonlat(folder.frame, p[None, :2])[0]
+        out.append({"type": "Feature", "geometry": {"type": "Point", "coordinates": [lon, lat]},
+                    "properties": {"name": name, "x_m": float(p[0]), "y_m": float(p[1])}})
+    return out
+
+
+def _layer_polygons(mask: np.ndarray, cell: tuple[float, float]) -> shapely.Geometry:
+    """The union of the True cells of an (nx, ny) layer as polygons in the local frame."""
+    from affine import Affine
+    from rasterio import features
+
+    grid = np.ascontiguousarray(mask.T.astype(np.uint8))  # rows = y, columns = x
+    transform = Affine(cell[0], 0.0, 0.0, 0.0, cell[1], 0.0)
+    parts = [shapely.geometry.shape(g) for g, v in features.shapes(grid, mask=grid.astype(bool), transform=transform) if v]
+    return shapely.union_all(parts)
+
+
+def unsafe_features(folder: ScheduleFolder, unsafe: np.ndarray, obstacle: np.ndarray, cell, z: np.ndarray,
+                    band: tuple[float, float] | None) -> list[dict]:
+    """One (Multi)Polygon feature per layer with unsafe cells, right-hand rule (RFC 7946)."""
+    out = []
+    for k in range(unsafe.shape[2]):
+        if not unsafe[:, :, k].any():
+            continue
+        local = _layer_polygons(unsafe[:, :, k], cell[:2])
+        geo = shapely.transform(local, lambda xy: _lonlat(folder.frame, xy))
+        polys = [orient(p, sign=1.0) for p in shapely.get_parts(geo)]
+        geom = polys[0] if len(polys) == 1 else shapely.MultiPolygon(polys)
+        out.append({"type": "Feature", "geometry": shapely.geometry.mapping(geom),
+                    "properties": {"layer": k, "z_bottom_m": float(z[k] - cell[2] / 2), "z_top_m": float(z[k] + cell[2] / 2),
+                                   "z_centre_m": float(z[k]), "in_band": None if band is None else bool(band[0] - 1e-9 <= z[k] <= band[1] + 1e-9),
+                                   "unsafe_cells": int(unsafe[:, :, k].sum()), "obstacle_cells": int(obstacle[:, :, k].sum())}})
+    return out
+
+
+def _unsafe_layers(folder: ScheduleFolder, risk: str | Path | None, scenario: str | None, overrides: list[str] | None):
+    """(unsafe, obstacle, cell, z, band) from a risk.npz or from the recorded scenario."""
+    if risk is not None:
+        path = Path(risk)
+        if not path.is_file():
+            raise InputFileError(f"risk file not found: {path}", "--risk", "give a risk.npz written by uamopt risk")
+        try:
+            with np.load(path) as data:
+                unsafe, obstacle, z = data["unsafe"].astype(bool), data["obstacle"].astype(bool), data["z"]
+                cell = tuple(float(c) for c in data["cell"])
+                band = None  # risk.npz does not record the altitude band
+        except (OSError, KeyError, ValueError) as exc:
+            raise InputFileError(f"cannot read {path.name}: {exc}", str(path), "give a risk.npz written by uamopt risk") from None
+        return unsafe, obstacle, cell, z, band
+    from uamopt.stages import compute_risk
+
+    field = compute_risk(recorded_scenario(folder, scenario, overrides)).field
+    return field.unsafe, field.obstacle, tuple(field.grid.cell), field.grid.z, tuple(field.band)
+
+
+def export_geojson(path: str | Path, *, risk: str | Path | None = None, scenario: str | None = None,
+                   overrides: list[str] | None = None) -> list[Path]:
+    """Write tracks.geojson, vertiports.geojson and unsafe.geojson into the schedule folder ``path``.
+
+    Raises
+    ------
+    InputFileError
+        The folder, a file in it or ``risk`` is missing or malformed, or the folder records no
+        scenario and neither ``risk`` nor ``scenario`` is given.
+    ScenarioError
+        The scenario file is missing or malformed.
+    """
+    folder = read_schedule_folder(path)
+    layers = _unsafe_layers(folder, risk, scenario, overrides)  # before writing anything
+    files = {"tracks.geojson": track_features(folder), "vertiports.geojson": vertiport_features(folder),
+             "unsafe.geojson": unsafe_features(folder, *layers)}
+    written = []
+    for name, features in files.items():
+        write_text_atomic(folder.path / name, _collection(features, folder, name.removesuffix(".geojson")))
+        written.append(folder.path / name)
+    return written

@@ -1,0 +1,156 @@
+"""Loaders: every folder a command writes reads back into the objects that wrote it.
+
+``load_risk`` (risk.npz + summary.json → RiskField), ``load_tracks`` (tracks.json → TrackPlan),
+``load_network`` (network.json → RouteNetwork), ``load_flights`` (flights.json → FlightSet) and
+``load_schedule`` (schedule.csv + summary.json → Schedule). Each takes the folder or the file.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from uamopt.errors import InputFileError
+
+if TYPE_CHECKING:
+    from uamopt.planning.network import RouteNetwork
+    from uamopt.planning.tracks import TrackPlan
+    from uamopt.risk import RiskField
+    from uamopt.schedule.flights import FlightSet
+    from uamopt.schedule.model import Schedule
+
+
+def _file(path: str | Path, name: str) -> Path:
+    path = Path(path)
+    path = path / name if path.is_dir() else path
+    if not path.is_file():
+        raise InputFileError(f"{name} not found: {path}", str(path), f"give a folder written by uamopt, or its {name}")
+    return path
+
+
+def _json(path: Path) -> dict:
+    try:
+        doc = json.loads(path.read_text(encoding="utf-8"))
+    except (ValueError, UnicodeDecodeError) as exc:
+        raise InputFileError(f"malformed JSON: {exc}", str(path), "regenerate the folder with uamopt") from None
+    if not isinstance(doc, dict):
+        raise InputFileError("the file does not hold a JSON object", str(path), "regenerate the folder with uamopt")
+    return doc
+
+
+def load_risk(path: str | Path) -> RiskField:
+    """The :class:`~uamopt.risk.RiskField` of a risk folder (``risk.npz`` and ``summary.json``)."""
+    from uamopt.city.layers import CityLayers
+    from uamopt.grid import AirspaceGrid
+    from uamopt.risk import RiskConstants, RiskField
+
+    npz = _file(path, "risk.npz")
+    summary = _json(_file(npz.parent, "summary.json"))
+    try:
+        with np.load(npz) as data:
+            a = {k: data[k] for k in data.files}
+        grid = AirspaceGrid(cell=tuple(float(c) for c in a["cell"]), shape=a["risk"].shape)  # type: ignore[arg-type]
+        city = CityLayers(
+            surface_height=a["surface_height"], building_height=a["building_height"], road_length=a["road_length"],
+            population_density=a["population_density"], shelter=a["shelter"], no_fly=a["no_fly"],
+            open_space=a.get("open_space", np.zeros_like(a["no_fly"])), source=summary.get("source", ""),
+            attribution=summary.get("attribution", ""), crs=summary.get("crs", ""),
+            origin=tuple(summary.get("origin", (0.0, 0.0))), notes=summary.get("city", {}))
+        rk = summary["risk_per_flight_hour"]
+        c = summary["constants"]
+        constants = RiskConstants(c["mass_kg"], c["crash_area_m2"], c["drag_k_per_m"], c["terminal_speed_mps"],
+                                  c["mean_relative_speed_mps"], c["vehicle_collision_probability"])
+        return RiskField(grid=grid, city=city, risk=a["risk"], risk_P=a["risk_P"], risk_V=a["risk_V"],
+                         risk_U=a["risk_U"], unsafe=a["unsafe"], obstacle=a["obstacle"],
+                         band=tuple(summary["band_m"]), constants=constants, threshold=float(rk["threshold_R0"]),  # type: ignore[arg-type]
+                         seconds=float(summary.get("seconds", {}).get("risk", 0.0)),
+                         meta={"scenario": summary.get("scenario", ""), "seconds": summary.get("seconds", {})})
+    except (KeyError, ValueError, TypeError) as exc:
+        raise InputFileError(f"incomplete risk folder: {exc}", str(npz.parent), "regenerate it with `uamopt risk`") from None
+
+
+def load_tracks(path: str | Path) -> TrackPlan:
+    """The :class:`~uamopt.planning.tracks.TrackPlan` of a plan folder (``tracks.json``)."""
+    from uamopt.planning.tracks import TrackPlan
+
+    file = _file(path, "tracks.json")
+    try:
+        return TrackPlan.from_dict(_json(file))
+    except (KeyError, ValueError, TypeError) as exc:
+        raise InputFileError(f"malformed tracks file: {exc}", str(file), "regenerate it with `uamopt plan`") from None
+
+
+def load_network(path: str | Path) -> RouteNetwork:
+    """The :class:`~uamopt.planning.network.RouteNetwork` of a network folder (``network.json``)."""
+    from uamopt.planning.network import load_network as load
+
+    return load(_file(path, "network.json"))
+
+
+def load_flights(path: str | Path, scenario=None, grid=None, network=None) -> FlightSet:
+    """The :class:`~uamopt.schedule.flights.FlightSet` of ``flights.json`` (validated)."""
+    from uamopt.schedule.flights import load_flights as load
+
+    return load(_file(path, "flights.json"), scenario, grid, network)
+
+
+def load_schedule(path: str | Path) -> Schedule:
+    """The :class:`~uamopt.schedule.model.Schedule` of a schedule folder (``schedule.csv`` and
+    ``summary.json``), rows in schedule.csv order."""
+    from uamopt.schedule.model import Schedule
+
+    file = _file(path, "schedule.csv")
+    summary = _json(_file(file.parent, "summary.json"))
+    try:
+        with open(file, newline="", encoding="utf-8-sig") as fh:
+            rows = list(csv.DictReader(fh))
+        operated = np.array([r["operated"].strip() == "1" for r in rows], dtype=bool)
+        delay = np.array([float(r["delay_s"]) for r in rows], dtype=float)
+        return Schedule(
+            solver=str(summary["solver"]), status=summary["status"], operated=operated, delay_s=delay,
+            objective=summary.get("objective"), bound=summary.get("bound"), gap=summary.get("gap"),
+            solve_seconds=float(summary.get("solve_seconds", 0.0)), seed=summary.get("seed"),
+            aircraft_count=int(summary.get("aircraft", 1)), extras=dict(summary.get("extras", {})),
+            flight_ids=tuple(r["flight"] for r in rows))
+    except (KeyError, ValueError, TypeError, AttributeError) as exc:
+        raise InputFileError(f"malformed schedule folder: {exc}", str(file.parent),
+                             "regenerate it with `uamopt schedule`") from None
+
+
+# --- writers: what the commands write, so every folder loads back with the loaders above -------
+
+
+def save_risk(field: RiskField, folder: str | Path) -> None:
+    """``risk.npz`` and ``summary.json`` of a risk folder."""
+    from uamopt.outputs import write_json
+
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    field.save_npz(folder / "risk.npz")
+    write_json(folder / "summary.json", field.summary())
+
+
+def save_tracks(plan: TrackPlan, folder: str | Path, scenario=None) -> None:
+    """``tracks.json`` of a plan folder (INTERFACES: stages with waypoints and metrics)."""
+    from uamopt.outputs import write_json
+
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    doc = plan.as_dict()
+    if scenario is not None:
+        doc["scenario"] = {"name": scenario.name, "file": scenario.source, "cell": list(scenario.grid.cell),
+                           "weights": list(scenario.tracks.weights)}
+    write_json(folder / "tracks.json", doc)
+
+
+def save_network(network: RouteNetwork, folder: str | Path) -> None:
+    """``network.json`` of a network folder."""
+    from uamopt.outputs import write_json
+
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    write_json(folder / "network.json", network.to_document())

@@ -1,0 +1,153 @@
+"""The pipeline as plain functions: what every command runs, one call per stage (PyPSA's pattern).
+
+::
+
+    import uamopt as ua
+    scenario = ua.load_scenario("models/paper_case.toml", ["grid.cell=[25,25,30]"])
+    field    = ua.compute_risk(scenario)                  # RiskField; field.summary() -> dict
+    model    = ua.planning_model(scenario, field)         # admissible cells, edge costs (Sec. 4.2)
+    plan     = ua.plan_track(model, "V1", "V4")           # or (x, y, z) in metres; plan.to_frame()
+    network  = ua.plan_network(model)                     # RouteNetwork; network.to_frame()
+    flights  = ua.generate_flights(scenario, network)     # FlightSet; flights.to_frame()
+    problem  = ua.build_problem(flights, scenario)        # SchedulingProblem (conflicts computed)
+    schedule = ua.solve(problem, "highs", time_limit_s=30)  # Schedule; schedule.to_frame()
+    check    = ua.verify(problem, schedule)               # Verification: .ok, .violations
+
+Data flows one way; each stage takes the previous stage's typed value and never reaches back
+into its internals. The CLI (``uamopt.cli``) only parses arguments and writes files.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import tempfile
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from uamopt.scenario import Scenario
+
+if TYPE_CHECKING:
+    import pandas as pd
+
+    from uamopt.planning.network import RouteNetwork
+    from uamopt.planning.problem import PlanningModel
+    from uamopt.risk import RiskField
+    from uamopt.schedule.flights import FlightSet
+    from uamopt.schedule.model import Schedule, SchedulingProblem
+    from uamopt.solvers import SolverProfile
+
+
+def compute_risk(scenario: Scenario) -> RiskField:
+    """Grid, city layers and the risk field of Eqs. 1–9 / A.1–A.9 (Sec. 3, 4.1.1, App. A).
+
+    The returned field carries its timings in ``meta["seconds"]`` (city, risk, total) and
+    ``summary()`` gives the risk command's ``summary.json``.
+    """
+    from uamopt.city import load_city
+    from uamopt.grid import build_grid
+    from uamopt.risk import risk_field
+
+    t0 = time.perf_counter()
+    grid = build_grid(scenario)
+    city = load_city(scenario, grid)
+    t1 = time.perf_counter()
+    field = risk_field(scenario, grid, city)
+    t2 = time.perf_counter()
+    field.meta["seconds"] = {"city": t1 - t0, "risk": t2 - t1, "total": t2 - t0}
+    return field
+
+
+def planning_model(scenario: Scenario, field: RiskField) -> PlanningModel:
+    """Admissible cells, Eq. 11 risk, the safety buffer R(t) of Eq. 35 and transport rates."""
+    from uamopt.planning.problem import planning_model as build
+
+    return build(scenario, field)
+
+
+def plan_track(model: PlanningModel, origin=None, destination=None, **options):
+    """The four stages of Fig. 18 / Table 2 between two points (x, y, z m) or vertiport names;
+    omitted: the scenario's route (``tracks.route``, else the first and farthest vertiports)."""
+    from uamopt.planning.endpoints import default_endpoints
+    from uamopt.planning.tracks import plan_track as plan
+
+    if origin is None or destination is None:
+        o, d = default_endpoints(model.scenario)
+        origin = o if origin is None else origin
+        destination = d if destination is None else destination
+    return plan(model, origin, destination, **options)
+
+
+def plan_network(model: PlanningModel, progress=None) -> RouteNetwork:
+    """One planned track per route and direction, directions on separate layers (Sec. 4.1.2, 6.2)."""
+    from uamopt.planning.network import plan_network as plan
+
+    return plan(model, progress=progress)
+
+
+def generate_flights(scenario: Scenario, network, seed: int | None = None) -> FlightSet:
+    """The initial flight plan of Sec. 6.2 (Eqs. 23–29) on ``network`` (a RouteNetwork or route
+    name → waypoints); ``seed`` defaults to ``schedule.plan_seed``."""
+    from uamopt.schedule.plan import generate_plan
+
+    return generate_plan(scenario, network, scenario.schedule.plan_seed if seed is None else int(seed))
+
+
+def build_problem(flights: FlightSet, scenario: Scenario | None = None, *, objective: str | None = None,
+                  weights: tuple[float, float] | None = None) -> SchedulingProblem:
+    """The scheduling model as data (pair conflicts computed); ``objective`` defaults to
+    ``schedule.objective`` (weighted Eq. 20, or lexicographic)."""
+    from uamopt.schedule.model import build_problem as build
+
+    kind = objective or (scenario.schedule.objective if scenario is not None else "weighted")
+    return build(flights, scenario, weights=weights, objective=kind)  # type: ignore[arg-type]
+
+
+def solver_profile(profile: SolverProfile | str | Path, **overrides) -> SolverProfile:
+    """A profile by name (``highs``), path or object, with ``time_limit_s``, ``seed``,
+    ``threads`` or ``options`` replaced."""
+    from uamopt.solvers import SolverProfile, load_profile
+
+    base = profile if isinstance(profile, SolverProfile) else load_profile(profile)
+    if "options" in overrides:
+        overrides["options"] = {**base.options, **overrides["options"]}
+    return dataclasses.replace(base, **overrides) if overrides else base
+
+
+def solve(problem: SchedulingProblem, profile: SolverProfile | str | Path = "greedy", **overrides) -> Schedule:
+    """Run one solver profile on the problem, e.g. ``solve(problem, "highs", time_limit_s=30)``."""
+    from uamopt.solvers import solve as run
+
+    return run(problem, solver_profile(profile, **overrides))
+
+
+@dataclass(frozen=True)
+class Verification:
+    """The independent verifier's verdict on a schedule (``uamopt verify``)."""
+
+    ok: bool
+    messages: tuple[str, ...]
+
+    @property
+    def violations(self) -> pd.DataFrame:
+        """One row per violation: ``kind`` (conflict, turnaround, delay, ...) and ``message``."""
+        import pandas as pd
+
+        return pd.DataFrame({"kind": [m.split(":", 1)[0] for m in self.messages], "message": list(self.messages)})
+
+    def __bool__(self) -> bool:
+        return self.ok
+
+
+def verify(problem: SchedulingProblem, schedule: Schedule) -> Verification:
+    """Write the schedule as its files and check them with the independent verifier, which shares
+    no code with the model (``uamopt.schedule.verify``)."""
+    from uamopt.schedule.model import write_schedule
+    from uamopt.schedule.verify import verify_dir
+
+    with tempfile.TemporaryDirectory(prefix="uamopt-verify-") as tmp:
+        folder = Path(tmp) / "schedule"
+        write_schedule(folder, problem, schedule)
+        messages = tuple(verify_dir(folder))
+    return Verification(ok=not messages, messages=messages)
