@@ -1,4 +1,4 @@
-"""``uamopt sweep``: resumable Dask sweeps (INTERFACES.md "Sweep files").
+"""``uamopt sweep``: resumable Dask sweeps (docs/sweeps.md).
 
 The reference is one uninterrupted run of tests/data/sweeps/tiny.toml (4 cases × greedy, HiGHS)
 on a separately started ``dask scheduler`` + two ``dask worker`` processes (conftest.py); a run on
