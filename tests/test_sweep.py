@@ -1,4 +1,4 @@
-"""``uamopt sweep``: resumable Dask sweeps (INTERFACES.md "Sweep files").
+"""``uamopt sweep``: resumable Dask sweeps (docs/interfaces.md "Sweep files").
 
 The reference is one uninterrupted run of tests/data/sweeps/tiny.toml (4 cases × greedy, HiGHS);
 an interrupted-and-resumed run and a run on a separately started Dask cluster must give the same
