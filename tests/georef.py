@@ -24,3 +24,13 @@ def hand_lonlat(x, y, lon0: float = ANCHOR_LONLAT[0], lat0: float = ANCHOR_LONLA
     s = np.sin(np.radians(lat))
     n = A / np.sqrt(1 - E2 * s * s)
     return lon0 + np.degrees(np.asarray(x, float) / (n * np.cos(np.radians(lat)))), lat
+
+
+def hand_local(lon, lat, lon0: float = ANCHOR_LONLAT[0], lat0: float = ANCHOR_LONLAT[1]):
+    """(x, y) in metres of points (lon, lat) in degrees: the inverse of :func:`hand_lonlat`."""
+    s = math.sin(math.radians(lat0))
+    m = A * (1 - E2) / (1 - E2 * s * s) ** 1.5
+    lat = np.asarray(lat, float)
+    s = np.sin(np.radians(lat))
+    n = A / np.sqrt(1 - E2 * s * s)
+    return np.radians(np.asarray(lon, float) - lon0) * n * np.cos(np.radians(lat)), np.radians(lat - lat0) * m

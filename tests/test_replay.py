@@ -101,12 +101,18 @@ def test_paper_case_window_replays_with_no_loss_of_separation(paper_schedule_dir
     assert out["flights_replayed"] == sum(1 for f in out["flights"] if 0 <= f["departure_s"] <= 600) >= 15
     assert out["zone"]["rpz_m"] == pytest.approx(29.5) and out["zone"]["hpz_m"] == pytest.approx(25.5)
     assert out["settings"]["bluesky_zone_m"] == pytest.approx([29.5, 25.5], abs=1e-3)  # BlueSky's own units round trip
-    # measured fidelity (regression values of BlueSky 1.1.1, EC35, bank 45°, dt 0.05 s; docs/export.md)
+    # measured fidelity (regression values of BlueSky 1.1.1, EC35, bank 45°, dt 0.05 s, designed
+    # trajectories; docs/export.md): the designed trajectories keep within 7.96 m of the plan, BlueSky
+    # within ~0.8 m of them
+    assert out["settings"]["trajectory"] == "designed"
     dev = out["deviation"]
-    assert dev["max_horizontal_error_m"]["max"] < 10.0
-    assert dev["max_cross_track_m"]["max"] < 6.0
+    assert dev["max_horizontal_error_m"]["max"] < 9.0
+    assert dev["max_cross_track_m"]["max"] < 7.0
     assert dev["max_vertical_error_m"]["max"] < 0.05
-    assert -0.5 < dev["arrival_deviation_s"]["min"] <= dev["arrival_deviation_s"]["max"] < 0.2
+    assert -0.3 < dev["arrival_deviation_s"]["min"] <= dev["arrival_deviation_s"]["max"] < 0.1
+    for f in out["flights"]:
+        assert f["max_horizontal_error_m"] < f["designed_error_m"] + 1.5
+        assert 18.0 < f["commanded_speed_mps"][0] <= f["commanded_speed_mps"][1] < 32.0
     # the closest approach of any pair keeps one of the two separations the cell model guarantees
     for p in out["near_pairs"]:
         assert p["closest_horizontal_m"] >= 29.5 or p["closest_vertical_m"] >= 25.5
@@ -136,7 +142,7 @@ def test_verifier_conflicts_are_near_pairs_and_when_they_are_not_losses(planted)
     problems = verify_dir(folder)
     assert any("P1 (A1)" in p and "P2 (A2)" in p for p in problems)
     assert any("P3 (A3)" in p and "P4 (A4)" in p for p in problems)
-    near = {tuple(p["flights"]): p for p in out["near_pairs"]}
+    near = {tuple(sorted(p["flights"])): p for p in out["near_pairs"]}  # in order of departure
     assert set(near) == {("P1", "P2"), ("P3", "P4")}
     offset = near[("P3", "P4")]
     assert offset["los_steps"] == 0
@@ -160,6 +166,19 @@ def test_replay_bad_input(tmp_path, capsys):
     assert main(["replay", str(tmp_path), "--zone", "30"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 2 and all(line.startswith("error: ") for line in err)
+
+
+@pytest.mark.slow
+def test_track_waypoints_flown_at_constant_speed_leave_the_budget(paper_schedule_dir, tmp_path):
+    """The "before": BlueSky handed the tracks' own waypoints at v_g cuts each corner with a fly-by
+    turn and stays ahead of the plan after it (docs/export.md), well beyond e_h = 10 m."""
+    folder = tmp_path / "waypoints"
+    shutil.copytree(paper_schedule_dir, folder)
+    result = replay(folder, window_s=(0.0, 600.0), trajectory="waypoints", write=False)
+    errors = [f["max_horizontal_error_m"] for f in result.flights]
+    assert result.los_count == 0 and max(errors) > 20.0 and len(result.over_budget) > len(errors) / 2
+    assert max(f["arrival_deviation_s"] for f in result.flights) < -0.05  # every flight early
+    print(f"waypoints: max horizontal error {max(errors):.1f} m, {len(result.over_budget)} of {len(errors)} over budget")
 
 
 @pytest.mark.slow

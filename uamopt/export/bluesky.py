@@ -3,7 +3,13 @@
 BlueSky (TU Delft, PyPI ``bluesky-simulator``) replays the schedule with its own aircraft
 dynamics and its own loss-of-separation detection (:mod:`uamopt.sim.replay`). Every operated flight
 becomes one aircraft, created at its scheduled departure at the first point of its track, flying
-the track's waypoints at v_g and deleted when it passes the last one. Writing needs no BlueSky.
+its trajectory and deleted when it passes the last point. Writing needs no BlueSky.
+
+The trajectory (``trajectory``): by default the flyable trajectory nearest to the plan
+(:mod:`uamopt.export.trajectory`: the plan turns instantly, an aircraft cannot; the design keeps
+to the plan's position *and time* within the acceleration of the bank limit, e.g. ≤ 8.0 m on
+the paper case's tracks); ``"waypoints"`` hands BlueSky the track's own waypoints at v_g, whose
+corners BlueSky cuts with its fly-by turns while flying on at v_g, ahead of the plan after each.
 
 Faithful to the plan, within what the simulator can do (measured figures in docs/export.md):
 
@@ -12,14 +18,14 @@ Faithful to the plan, within what the simulator can do (measured figures in docs
   speeds are not read as Mach), converted from the true airspeed by the ISA (no wind: TAS = ground
   speed).
 - BlueSky moves aircraft over a sphere of radius 6 371 km while the frame's metres are the CRS's:
-  the commanded speed of each leg is v_g × (spherical length / planned length), so that every leg
-  takes its planned time (a ±0.3 % correction; without it the drift reaches ~10 m over 4 km).
+  each leg is commanded at its length on that sphere / its time, so that it takes its time (for
+  the plan's waypoints: v_g corrected by ≤ 0.3 %; without it the drift reaches ~10 m over 4 km).
 - BlueSky steps its clock by ``dt``: an aircraft is created at the first step t_k ≥ departure, at
-  the point of its track the plan reaches at t_k (so the step does not delay it).
+  the point its trajectory reaches at t_k (so the step does not delay it).
 - The aircraft type is EC35 (a helicopter that hovers, ≤ 72 m/s, ±7.6 m/s vertical) standing in
   for the eVTOL, with bank limit ``bank_deg`` (default 45°: turn radius v²/(g tan φ) = 64 m at
-  25 m/s; BlueSky's 25° gives 137 m and cuts corners by up to ~60 m on our tracks). Waypoints are
-  fly-by, VNAV with top-of-climb/descent logic off, so climbs follow the planned gradient.
+  25 m/s; BlueSky's 25° gives 137 m). Points are fly-by, VNAV with top-of-climb/descent logic
+  off, so climbs follow the planned gradient.
 - Detection: ``CDMETHOD STATEBASED``, resolution off, protected zone (``ZONER``, ``ZONEDH``) from
   the replay's zone (see :func:`uamopt.sim.zone.protected_zone`).
 """
@@ -33,7 +39,15 @@ from pathlib import Path
 
 import numpy as np
 
+from uamopt.errors import UamoptError
 from uamopt.export.folder import ScheduleFolder, read_schedule_folder, write_text_atomic
+from uamopt.export.trajectory import (
+    ACCEL_SHARE,
+    DESIGN_STEP_S,
+    Trajectory,
+    flyable_trajectory,
+    plan_trajectory,
+)
 
 FT_M = 0.3048
 KT_MPS = 1852.0 / 3600.0
@@ -42,6 +56,8 @@ R_EARTH_BLUESKY_M = 6371000.0  # bluesky.tools.aero.Rearth: the sphere aircraft 
 AIRCRAFT_TYPE = "EC35"
 DEFAULT_BANK_DEG = 45.0
 DEFAULT_DT_S = 0.05
+TRAJECTORIES = ("designed", "waypoints")
+DEFAULT_TRAJECTORY = "designed"
 
 
 def tas_to_cas(tas_mps: np.ndarray, altitude_m: np.ndarray) -> np.ndarray:
@@ -79,20 +95,6 @@ def first_step_s(departure_s: float, dt_s: float) -> float:
     return math.ceil(departure_s / dt_s - 1e-9) * dt_s
 
 
-def track_from(waypoints: np.ndarray, distance_m: float) -> np.ndarray:
-    """The rest of a track from ``distance_m`` along it: the point there, then the later waypoints."""
-    if distance_m <= 0.0:
-        return waypoints
-    seg = np.linalg.norm(np.diff(waypoints, axis=0), axis=1)
-    cum = np.concatenate([[0.0], np.cumsum(seg)])
-    k = min(int(np.searchsorted(cum, distance_m, side="right")) - 1, len(seg) - 1)
-    start = waypoints[k] + min(1.0, (distance_m - cum[k]) / seg[k]) * (waypoints[k + 1] - waypoints[k])
-    rest = waypoints[k + 1:]
-    if len(rest) > 1 and np.linalg.norm(rest[0] - start) < 1e-6:
-        rest = rest[1:]  # the step ends on a waypoint: do not repeat it
-    return np.vstack([start, rest])
-
-
 def aircraft_ids(flight_ids: Sequence[str]) -> dict[str, str]:
     """BlueSky callsigns: the flight id in upper-case letters and digits, made unique."""
     out: dict[str, str] = {}
@@ -116,20 +118,42 @@ def _stamp(t_s: float) -> str:
     return f"{int(h):02d}:{int(m):02d}:{s:06.3f}>"
 
 
-def flight_commands(acid: str, waypoints: np.ndarray, speed_mps: float, frame, bank_deg: float) -> list[str]:
-    """CRE, BANK, ADDWPT..., AT-last-waypoint DEL, LNAV/VNAV: one aircraft flying ``waypoints`` at v_g.
+def flight_trajectories(flights: Sequence, bank_deg: float = DEFAULT_BANK_DEG,
+                        trajectory: str = DEFAULT_TRAJECTORY) -> dict[str, Trajectory]:
+    """What each operated flight commands, times from its departure: flight id -> :class:`Trajectory`.
 
-    Repeated points (legs of zero length) are dropped: BlueSky would fly them at zero speed.
+    ``trajectory = "designed"``: the flyable trajectory nearest to the plan
+    (:func:`~uamopt.export.trajectory.flyable_trajectory`, designed once per track);
+    ``"waypoints"``: the track's own waypoints at v_g (BlueSky then cuts their corners on its own).
     """
-    keep = np.concatenate([[True], np.linalg.norm(np.diff(waypoints, axis=0), axis=1) > 1e-6])
-    waypoints = waypoints[keep]
-    lon, lat = frame.to_lonlat(waypoints[:, 0], waypoints[:, 1])
-    z = waypoints[:, 2]
-    planned = np.linalg.norm(np.diff(waypoints, axis=0), axis=1)
+    if trajectory not in TRAJECTORIES:
+        raise UamoptError(f"unknown trajectory {trajectory!r}", "--trajectory", f"choose one of {', '.join(TRAJECTORIES)}")
+    designed: dict[tuple, Trajectory] = {}
+    out = {}
+    for o in flights:
+        wp = np.asarray(o.flight.waypoints, float)
+        if trajectory == "waypoints":
+            out[o.flight.id] = plan_trajectory(wp, o.flight.speed_mps)
+            continue
+        key = (wp.tobytes(), o.flight.speed_mps)
+        if key not in designed:
+            designed[key] = flyable_trajectory(wp, o.flight.speed_mps, bank_deg)
+        out[o.flight.id] = designed[key]
+    return out
+
+
+def flight_commands(acid: str, trajectory: Trajectory, frame, bank_deg: float) -> list[str]:
+    """CRE, BANK, ADDWPT..., AT-last-point DEL, LNAV/VNAV: one aircraft flying ``trajectory`` (clock times).
+
+    Every leg is commanded at the airspeed that makes it last its time on BlueSky's sphere.
+    """
+    points, times = trajectory.points, trajectory.times_s
+    lon, lat = frame.to_lonlat(points[:, 0], points[:, 1])
+    z = points[:, 2]
     ground = sphere_distance_m(lon[:-1], lat[:-1], lon[1:], lat[1:])
-    tas = speed_mps * ground / np.maximum(planned, 1e-9)  # leg time = planned length / v_g
+    tas = ground / np.diff(times)  # no wind: TAS = ground speed; BlueSky's speeds are horizontal
     cas_kt = tas_to_cas(tas, 0.5 * (z[:-1] + z[1:])) / KT_MPS
-    cas_kt = np.append(cas_kt, cas_kt[-1])  # VNAV speeds are "from" speeds: waypoint i sets leg i
+    cas_kt = np.append(cas_kt, cas_kt[-1])  # VNAV speeds are "from" speeds: point i sets leg i
     alt_ft = np.maximum(z / FT_M, 0.1)  # ADDWPT ignores an altitude of exactly 0
     hdg = sphere_bearing_deg(lon[0], lat[0], lon[1], lat[1])
     end = f"{acid}_END"
@@ -143,21 +167,27 @@ def flight_commands(acid: str, waypoints: np.ndarray, speed_mps: float, frame, b
 
 
 def scenario_text(folder: ScheduleFolder, zone_m: tuple[float, float], *, dt_s: float = DEFAULT_DT_S,
-                  bank_deg: float = DEFAULT_BANK_DEG, flights: Sequence | None = None) -> str:
+                  bank_deg: float = DEFAULT_BANK_DEG, flights: Sequence | None = None,
+                  trajectory: str = DEFAULT_TRAJECTORY, designs: dict[str, Trajectory] | None = None) -> str:
     """The .scn text of the operated flights (or of ``flights``, a subset of ``folder.operated``).
 
     ``zone_m`` = (r_pz, h_pz): BlueSky's protected zone, horizontal radius and half height, m.
+    ``designs``: the flights' trajectories when already computed (:func:`flight_trajectories`).
     """
     frame = folder.frame
     chosen = folder.operated if flights is None else tuple(flights)
+    designs = designs or flight_trajectories(chosen, bank_deg, trajectory)
     ids = aircraft_ids([o.flight.id for o in folder.operated])
     rpz, hpz = zone_m
     lon0, lat0 = frame.to_lonlat(0.0, 0.0)
+    how = (f"designed: nearest flyable to the plan, acceleration ≤ {ACCEL_SHARE:g}·g·tan({bank_deg:g}°), "
+           f"nodes every {DESIGN_STEP_S:g} s" if trajectory == "designed" else "the tracks' own waypoints at v_g")
     head = [
         f"# uamopt schedule {folder.path.name}: {len(chosen)} operated flights replayed in BlueSky 1.1.1",
         (f"# frame ({frame.source}{'' if folder.frame_recorded else ': none recorded, synthetic anchor assumed'}): "
          f"local (0, 0) = lon {float(lon0):.7f}, lat {float(lat0):.7f}; CRS {frame.crs}"),
         f"# protected zone: r_pz = {rpz:.2f} m, h_pz = {hpz:.2f} m; clock step DT = {dt_s:g} s (creation times assume it)",
+        f"# trajectory: {how}",
         "# aircraft: flight id -> callsign " + ", ".join(f"{o.flight.id}={ids[o.flight.id]}" for o in chosen),
     ]
     setup = ["CASMACHTHR 0", f"DT {dt_s:g}", "CDMETHOD STATEBASED", "RESO OFF",
@@ -165,14 +195,15 @@ def scenario_text(folder: ScheduleFolder, zone_m: tuple[float, float], *, dt_s: 
     lines = [_stamp(0.0) + c for c in setup]
     for o in chosen:
         t_k = first_step_s(o.departure_s, dt_s)
-        track = track_from(np.asarray(o.flight.waypoints, float), o.flight.speed_mps * (t_k - o.departure_s))
+        rest = designs[o.flight.id].rest_from(t_k - o.departure_s)  # created at t_k where the trajectory is then
+        clock = Trajectory(rest.times_s + o.departure_s, rest.points, rest.max_error_m)
         stamp = _stamp(t_k - dt_s / 2)  # executes at the step whose clock reads t_k
-        lines += [stamp + c for c in flight_commands(ids[o.flight.id], track, o.flight.speed_mps, frame, bank_deg)]
+        lines += [stamp + c for c in flight_commands(ids[o.flight.id], clock, frame, bank_deg)]
     return "\n".join(head + lines) + "\n"
 
 
 def export_bluesky(path: str | Path, zone_m: tuple[float, float] | None = None, *, dt_s: float = DEFAULT_DT_S,
-                   bank_deg: float = DEFAULT_BANK_DEG) -> Path:
+                   bank_deg: float = DEFAULT_BANK_DEG, trajectory: str = DEFAULT_TRAJECTORY) -> Path:
     """Write ``DIR/bluesky.scn`` for the schedule folder ``path``; returns the file's path.
 
     ``zone_m`` defaults to :func:`uamopt.sim.zone.protected_zone` of the folder's cell and r.
@@ -189,5 +220,5 @@ def export_bluesky(path: str | Path, zone_m: tuple[float, float] | None = None, 
         zone = protected_zone(folder.flights.cell, folder.flights.conflict_radius)
         zone_m = (zone.rpz_m, zone.hpz_m)
     target = folder.path / "bluesky.scn"
-    write_text_atomic(target, scenario_text(folder, zone_m, dt_s=dt_s, bank_deg=bank_deg))
+    write_text_atomic(target, scenario_text(folder, zone_m, dt_s=dt_s, bank_deg=bank_deg, trajectory=trajectory))
     return target

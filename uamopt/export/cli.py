@@ -1,8 +1,10 @@
 """The ``export`` and ``replay`` subcommands (docs/interfaces.md), added to the main parser by one call.
 
-    uamopt export bluesky DIR [--dt S] [--bank DEG] [--zone RPZ,HPZ] [--budget EH,EV]   # DIR/bluesky.scn
+    uamopt export bluesky DIR [--dt S] [--bank DEG] [--trajectory designed|waypoints] [--zone RPZ,HPZ]
+                              [--budget EH,EV]                                       # DIR/bluesky.scn
     uamopt export geojson DIR [--risk risk.npz | --scenario FILE [--set K=V ...]]        # DIR/*.geojson
-    uamopt replay DIR [--dt S] [--bank DEG] [--zone RPZ,HPZ] [--budget EH,EV] [--window T0,T1]
+    uamopt replay DIR [--dt S] [--bank DEG] [--trajectory designed|waypoints] [--zone RPZ,HPZ] [--budget EH,EV]
+                      [--window T0,T1]
 
 ``replay`` exits 0 when BlueSky finds no loss of separation and every flight stays within the
 deviation budget, 1 otherwise (like ``uamopt verify``), 2 on bad input or a missing BlueSky.
@@ -30,13 +32,20 @@ def _pair(text: str | None, option: str, example: str) -> tuple[float, float] | 
 
 
 def _simulation_options(p) -> None:
-    from uamopt.export.bluesky import DEFAULT_BANK_DEG, DEFAULT_DT_S
+    from uamopt.export.bluesky import (
+        DEFAULT_BANK_DEG,
+        DEFAULT_DT_S,
+        DEFAULT_TRAJECTORY,
+        TRAJECTORIES,
+    )
     from uamopt.sim.zone import DEFAULT_BUDGET_H_M, DEFAULT_BUDGET_V_M
 
     p.add_argument("dir", help="a schedule folder written by uamopt schedule")
     p.add_argument("--dt", type=float, default=DEFAULT_DT_S, help=f"BlueSky clock step, s (default {DEFAULT_DT_S:g})")
     p.add_argument("--bank", type=float, default=DEFAULT_BANK_DEG, help=f"bank limit, degrees (default {DEFAULT_BANK_DEG:g})")
     p.add_argument("--zone", metavar="RPZ,HPZ", help="protected zone radius and half height, m (default: from the cells and r)")
+    p.add_argument("--trajectory", choices=TRAJECTORIES, default=DEFAULT_TRAJECTORY,
+                   help="designed: the flyable trajectory nearest to the plan (default); waypoints: the track's own at v_g")
     p.add_argument("--budget", metavar="EH,EV", help=f"deviation budget the zone allows for, m "
                                                     f"(default {DEFAULT_BUDGET_H_M:g},{DEFAULT_BUDGET_V_M:g})")
 
@@ -58,7 +67,8 @@ def cmd_export_bluesky(args) -> int:
     from uamopt.export.bluesky import export_bluesky
 
     _, zone = _zone(args, args.dir)
-    path = export_bluesky(args.dir, (zone.rpz_m, zone.hpz_m), dt_s=args.dt, bank_deg=args.bank)
+    path = export_bluesky(args.dir, (zone.rpz_m, zone.hpz_m), dt_s=args.dt, bank_deg=args.bank,
+                          trajectory=args.trajectory)
     print(f"BlueSky scenario (protected zone r_pz = {zone.rpz_m:g} m, h_pz = {zone.hpz_m:g} m) -> {path}")
     return 0
 
@@ -79,7 +89,7 @@ def cmd_replay(args) -> int:
     budget, zone = _zone(args, args.dir)
     window = _pair(args.window, "--window", "0,900")
     result = replay(args.dir, dt_s=args.dt, bank_deg=args.bank, budget_h_m=budget[0], budget_v_m=budget[1],
-                    zone_m=(zone.rpz_m, zone.hpz_m), window_s=window)
+                    zone_m=(zone.rpz_m, zone.hpz_m), window_s=window, trajectory=args.trajectory)
     d = result.as_dict()["deviation"]
     print(f"BlueSky replay: {len(result.flights)} flights, {result.los_count} losses of separation "
           f"(r_pz = {zone.rpz_m:g} m, h_pz = {zone.hpz_m:g} m), {len(result.near_pairs)} near pairs; deviation from the "

@@ -10,7 +10,9 @@ flew with our plan:
   flight stays within the deviation budget);
 - per pair that came near: the closest approach and the smallest horizontal distance;
 - per flight: largest cross-track distance to the track, largest horizontal and vertical error
-  against the planned position at the same time, and the arrival-time deviation.
+  against the planned position at the same time, and the arrival-time deviation; beside them the
+  commanded trajectory's own largest distance to the plan (``designed_error_m``, the part no
+  aircraft at this bank limit can avoid) and its speed range.
 
 Results: ``DIR/replay.json`` and the figure ``DIR/replay.png`` (docs/export.md). BlueSky is an
 optional dependency (``pip install 'uamopt[sim]'``).
@@ -31,7 +33,13 @@ from pathlib import Path
 import numpy as np
 
 from uamopt.errors import UamoptError
-from uamopt.export.bluesky import DEFAULT_BANK_DEG, DEFAULT_DT_S, scenario_text
+from uamopt.export.bluesky import (
+    DEFAULT_BANK_DEG,
+    DEFAULT_DT_S,
+    DEFAULT_TRAJECTORY,
+    flight_trajectories,
+    scenario_text,
+)
 from uamopt.export.folder import ScheduleFolder, read_schedule_folder, write_text_atomic
 from uamopt.sim.analysis import flight_deviation, pair_separations
 from uamopt.sim.zone import (
@@ -119,7 +127,7 @@ def _run_worker(scn: Path, until_s: float) -> tuple[dict, dict]:
 def replay(path: str | Path, *, dt_s: float = DEFAULT_DT_S, bank_deg: float = DEFAULT_BANK_DEG,
            budget_h_m: float = DEFAULT_BUDGET_H_M, budget_v_m: float = DEFAULT_BUDGET_V_M,
            zone_m: tuple[float, float] | None = None, window_s: tuple[float, float] | None = None,
-           write: bool = True) -> ReplayResult:
+           trajectory: str = DEFAULT_TRAJECTORY, write: bool = True) -> ReplayResult:
     """Replay the schedule folder ``path`` in BlueSky and compare it with the plan.
 
     Parameters
@@ -137,6 +145,9 @@ def replay(path: str | Path, *, dt_s: float = DEFAULT_DT_S, bank_deg: float = DE
     window_s : (t0, t1), optional
         Replay only the operated flights departing in [t0, t1], s (any subset of a verified
         schedule is verified).
+    trajectory : {"designed", "waypoints"}
+        What each aircraft is commanded (:func:`uamopt.export.bluesky.flight_trajectories`): the
+        flyable trajectory nearest to the plan (default) or the track's own waypoints at v_g.
     write : bool
         Write ``bluesky.scn`` (the scenario replayed), ``replay.json`` and ``replay.png`` into the folder.
 
@@ -160,17 +171,24 @@ def replay(path: str | Path, *, dt_s: float = DEFAULT_DT_S, bank_deg: float = DE
     chosen = [o for o in folder.operated if window_s is None or window_s[0] <= o.departure_s <= window_s[1]]
     if not chosen:
         raise UamoptError("no operated flight to replay", str(folder.path), "widen the window or schedule flights")
-    text = scenario_text(folder, (zone.rpz_m, zone.hpz_m), dt_s=dt_s, bank_deg=bank_deg, flights=chosen)
+    designs = flight_trajectories(chosen, bank_deg, trajectory)
+    text = scenario_text(folder, (zone.rpz_m, zone.hpz_m), dt_s=dt_s, bank_deg=bank_deg, flights=chosen,
+                         trajectory=trajectory, designs=designs)
     with tempfile.TemporaryDirectory(prefix="uamopt-scn-") as tmp:
         scn = Path(tmp) / "bluesky.scn"
         scn.write_text(text, encoding="utf-8")
         until = max(o.arrival_s for o in chosen) + 600.0
         meta, raw = _run_worker(scn, until)
     result = _compare(folder, chosen, zone, meta, raw)
+    for f in result[2]:
+        design = designs[f["flight"]]
+        f["designed_error_m"], f["commanded_speed_mps"] = design.max_error_m, list(design.speed_range_mps)
     settings = {"bluesky": meta["bluesky"], "aircraft_type": "EC35", "bank_deg": bank_deg, "dt_s": meta["dt_s"],
+                "trajectory": trajectory,
                 "cd_method": meta["cd_method"], "bluesky_zone_m": meta["zone_m"], "window_s": window_s,
                 "frame": folder.frame.as_dict(), "frame_recorded": folder.frame_recorded}
-    seconds = {"simulated": meta["end_s"], "simulation": meta["wall_s"], "total": time.perf_counter() - started}
+    seconds = {"simulated": meta["end_s"], "simulation": meta["wall_s"], "simulation_cpu": meta["cpu_s"],
+               "bluesky_cpu": meta["process_cpu_s"], "total": time.perf_counter() - started}
     result = ReplayResult(folder.path, zone, result[0], result[1], result[2], settings, seconds)
     if write:
         from uamopt.sim.plot import plot_replay

@@ -46,7 +46,7 @@ def run(scn: str, out: str, workdir: str, until_s: float) -> dict:
     chunks: list[tuple] = []
     los_open: dict[frozenset, float] = {}
     los_events: list[list] = []
-    started = time.perf_counter()
+    started, started_cpu = time.perf_counter(), time.process_time()
     steps = 0
     while bs.sim.simt < until_s:
         bs.sim.step()
@@ -74,6 +74,7 @@ def run(scn: str, out: str, workdir: str, until_s: float) -> dict:
     cat = [np.concatenate(c) if chunks else np.empty(0) for c in zip(*chunks)] if chunks else [np.empty(0)] * 5
     meta = {"acids": acids, "actypes": actypes, "los": los_events, "dt_s": float(bs.sim.simdt),
             "end_s": float(bs.sim.simt), "steps": steps, "wall_s": time.perf_counter() - started,
+            "cpu_s": time.process_time() - started_cpu, "process_cpu_s": time.process_time(),
             "cd_method": ConflictDetection.selected().__name__,
             "zone_m": [float(traf.cd.rpz_def), float(traf.cd.hpz_def)], "bluesky": _version()}
     np.savez_compressed(out, t=cat[0], ac=cat[1].astype(np.int32), lat=cat[2], lon=cat[3], alt=cat[4],
