@@ -172,5 +172,5 @@ def test_progress_bar_on_a_terminal():
         stream.flush()
         output = os.read(master, 65536).decode(errors="replace")
     os.close(master)
-    assert "sweep demo" in output and "3/3" in output and "\r" in output
+    assert "sweep demo" in output and "/3 [" in output and "\r" in output  # a bar redrawn in place
     assert "- started" not in output  # no plain lines on a terminal

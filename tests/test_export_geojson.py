@@ -6,6 +6,7 @@ of curvature (tests/georef.py), not from uamopt's projection.
 
 from __future__ import annotations
 
+import csv
 import json
 import shutil
 

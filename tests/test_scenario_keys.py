@@ -127,8 +127,8 @@ def test_random_vertiports_need_an_extent(tmp_path, capsys):
 
 #: Keys read only by `uamopt reproduce` and its report (checked statically below: reproduce is too
 #: slow to run here), with the file that reads them.
-READ_BY_REPRODUCE = {("TracksConfig", "table2_cell_m"): ("cli.py", "tracks.table2_cell_m"),
-                     ("TracksConfig", "table4_cells"): ("cli.py", "tracks.table4_cells"),
+READ_BY_REPRODUCE = {("TracksConfig", "table2_cell_m"): ("reproduce.py", "tracks.table2_cell_m"),
+                     ("TracksConfig", "table4_cells"): ("reproduce.py", "tracks.table4_cells"),
                      ("Scenario", "description"): ("report.py", "scenario.description")}
 
 

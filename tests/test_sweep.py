@@ -1,7 +1,8 @@
-"""``uamopt sweep``: resumable Dask sweeps (INTERFACES.md "Sweep files").
+"""``uamopt sweep``: resumable Dask sweeps (docs/sweeps.md).
 
-The reference is one uninterrupted run of tests/data/sweeps/tiny.toml (4 cases × greedy, HiGHS);
-an interrupted-and-resumed run and a run on a separately started Dask cluster must give the same
+The reference is one uninterrupted run of tests/data/sweeps/tiny.toml (4 cases × greedy, HiGHS)
+on a separately started ``dask scheduler`` + two ``dask worker`` processes (conftest.py); a run on
+the default local cluster that is killed after two cases and then resumed must give the same
 table row for row (timing aside). Solvers: real greedy and real HiGHS; workers: real processes.
 """
 

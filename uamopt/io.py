@@ -88,7 +88,7 @@ def load_network(path: str | Path) -> RouteNetwork:
     """The :class:`~uamopt.planning.network.RouteNetwork` of a network folder (``network.json``)."""
     from uamopt.planning.network import load_network as load
 
-    return load(_file(path, "network.json"))
+    return load(path)  # a folder or the file; "network file not found" names what is missing
 
 
 def load_flights(path: str | Path, scenario=None, grid=None, network=None) -> FlightSet:

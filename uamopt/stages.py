@@ -1,14 +1,13 @@
-"""The pipeline's stages as plain functions a notebook can call one by one (PyPSA's pattern):
-scenario → city layers → grid → risk field. Later stages (tracks, schedules) append here."""
+"""The risk stage bundled with its grid, city layers and timings (``RiskRun``), for the tests and
+benchmarks that want all of them; the public stages live in :mod:`uamopt.pipeline`."""
 
 from __future__ import annotations
 
-import time
 from dataclasses import dataclass
 
-from uamopt.city import CityLayers, load_city
-from uamopt.grid import AirspaceGrid, build_grid
-from uamopt.risk import RiskField, risk_field
+from uamopt.city import CityLayers
+from uamopt.grid import AirspaceGrid
+from uamopt.risk import RiskField
 from uamopt.scenario import Scenario
 
 
@@ -24,14 +23,11 @@ class RiskRun:
 
 
 def compute_risk(scenario: Scenario) -> RiskRun:
-    """Build the grid and city layers, then the risk field, timing each step."""
-    t0 = time.perf_counter()
-    grid = build_grid(scenario)
-    city = load_city(scenario, grid)
-    t1 = time.perf_counter()
-    field = risk_field(scenario, grid, city)
-    t2 = time.perf_counter()
-    return RiskRun(scenario, grid, city, field, {"city": t1 - t0, "risk": t2 - t1, "total": t2 - t0})
+    """The risk stage with its grid, city and timings (:func:`uamopt.pipeline.compute_risk`)."""
+    from uamopt.pipeline import compute_risk as risk
+
+    field = risk(scenario)
+    return RiskRun(scenario, field.grid, field.city, field, dict(field.meta["seconds"]))
 
 
 def risk_summary(run: RiskRun) -> dict:

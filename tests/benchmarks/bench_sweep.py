@@ -6,7 +6,9 @@ Both runs execute the same sweep file (written to a temporary folder: the paper 
 ``[grid]`` over the number of aircraft and the cruise speed, the preliminary strategy and SOA's
 profile: about 5 CPU seconds a case, so that the cluster's start-up, a few seconds, is amortised) into fresh results folders, one after the other in this process: first with
 ``workers = 1`` (serial, the same local-cluster machinery), then with ``--workers``. Printed: the
-wall time of each, the speed-up, the CPU seconds the run consumed (this process and its workers) and so the
+wall time of each, the speed-up, a machine check (the same pure-Python loop in ``--workers`` processes at once against one
+after the other: the ceiling any scale-out can reach on the machine as loaded now), the CPU
+seconds the run consumed (this process and its workers) and so the
 cores it actually got on average, the summed per-case solver seconds, the load average before and
 after each run (other processes sharing the cores slow the parallel run more than the serial
 one), and whether the two tables agree row for row (timing aside).
@@ -59,6 +61,32 @@ def timed(path: Path, out: Path, workers: int):
     return wall, table
 
 
+def _spin(n: int) -> int:
+    total = 0
+    for i in range(n):
+        total += i * i % 7
+    return total
+
+
+def machine_check(workers: int, n: int = 15_000_000) -> float:
+    """What the machine gives right now: a pure-Python loop in ``workers`` processes at once
+    against the same loops one after the other (the ceiling of any scale-out measured now)."""
+    import multiprocessing
+
+    t0 = time.perf_counter()
+    for _ in range(workers):
+        _spin(n)
+    serial = time.perf_counter() - t0
+    with multiprocessing.get_context("spawn").Pool(workers) as pool:
+        pool.map(_spin, [1] * workers)  # start the processes before timing
+        t0 = time.perf_counter()
+        pool.map(_spin, [n] * workers)
+        parallel = time.perf_counter() - t0
+    print(f"machine check: {workers} pure-Python loops {serial:.1f} s one after the other, {parallel:.1f} s at once: "
+          f"speed-up ceiling {serial / parallel:.2f}x now", flush=True)
+    return serial / parallel
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--workers", type=int, default=2)
@@ -71,6 +99,7 @@ def main() -> None:
         path.write_text(SWEEP.format(cases=args.cases, base=(ROOT / "models" / "paper_case.toml").as_posix(),
                                      speeds=speeds))
         print(f"{args.cases} cases, {os.cpu_count()} CPUs, load average at start {load()}", flush=True)
+        machine_check(args.workers)
         serial, a = timed(path, folder / "serial", 1)
         parallel, b = timed(path, folder / f"w{args.workers}", args.workers)
         same = a.drop(columns="seconds").equals(b.drop(columns="seconds"))

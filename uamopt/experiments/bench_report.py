@@ -88,17 +88,15 @@ def performance_ratios(table):
     return ratios.astype(float)
 
 
-def plot_performance_profile(table, path: str | Path | None = None, ax=None):
-    """Dolan–Moré profile: fraction of instances with ratio ≤ τ, one step line per profile."""
-    from matplotlib.figure import Figure
+def plot_performance_profile(table, ax=None):
+    """Dolan–Moré profile: fraction of instances with ratio ≤ τ, one step line per profile.
+    ``ax`` as in :mod:`uamopt.plotting` (None, a Figure, or an Axes); returns the Figure."""
+    from uamopt.plotting.style import single_axes
 
     ratios = performance_ratios(table)
     finite = ratios.to_numpy()[np.isfinite(ratios.to_numpy())]
     tau_max = max(1.05, float(finite.max()) * 1.05 if finite.size else 2.0)
-    if ax is None:
-        fig = Figure(figsize=(6.5, 4.2), dpi=130)
-        ax = fig.add_subplot(1, 1, 1)
-    fig = ax.figure
+    fig, ax, _ = single_axes(ax, (6.5, 4.2))
     n = len(ratios)
     for profile in ratios.columns:
         r = np.sort(ratios[profile].to_numpy())
@@ -112,8 +110,6 @@ def plot_performance_profile(table, path: str | Path | None = None, ax=None):
     ax.set_title(f"Performance profile over {n} instances (median over seeds)")
     ax.grid(alpha=0.3)
     ax.legend(loc="lower right")
-    if path is not None:
-        fig.savefig(path, bbox_inches="tight")
     return fig
 
 
@@ -149,11 +145,12 @@ def bench_markdown(table) -> str:
 def write_bench(out: str | Path, table) -> str:
     """Write bench.csv, bench.md (and performance_profile.png) into ``out``, all or nothing."""
     from uamopt.outputs import staged_output
+    from uamopt.plotting.style import save
 
     text = bench_markdown(table)
     with staged_output(out) as stage:
         table.to_csv(stage / "bench.csv", index=False, na_rep="")
         (stage / "bench.md").write_text(text, encoding="utf-8")
         if table["instance"].nunique() > 1:
-            plot_performance_profile(table, stage / "performance_profile.png")
+            save(plot_performance_profile(table), stage / "performance_profile.png")
     return text

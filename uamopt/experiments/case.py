@@ -5,7 +5,7 @@ the engine adds the case id, the swept values and the version. A failure inside 
 an ``error`` row (status ``"error"``, the one-line message) instead of an exception, so one bad
 case never stops a sweep.
 
-Row keys by stage (INTERFACES.md "Sweep files"):
+Row keys by stage (docs/sweeps.md, docs/interfaces.md "Sweep files"):
 
 - every stage: ``status``, ``seconds`` (this stage's own computing time), ``error``, and the risk
   field's ``unsafe_share`` (Eq. 9, whole grid), ``band_unsafe_share`` (free cells of the altitude

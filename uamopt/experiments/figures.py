@@ -30,13 +30,19 @@ KEYS = {"altitude": "network.cruise_altitude_m", "cell": "grid.cell", "weights":
 PAPER_TABLE4 = {"[10.0, 10.0, 10.0]": (196.0, 27.1527, 386, 68.71), "[5.0, 5.0, 5.0]": (163.33, 25.7975, 636, 659.52)}
 
 
-def _axes(ax, panels: int, width: float = 5.2):
-    from matplotlib.figure import Figure
+def _axes(ax, count: int, width: float = 5.2):
+    """(figure, axes) from ``ax`` as every plot of uamopt.plotting takes it: None (a new page), a
+    Figure or SubFigure (the page laid out in it), one Axes (the first panel only) or one Axes
+    per panel."""
+    from uamopt.plotting.style import panels
 
-    if ax is not None:
-        return ax.figure, [ax]
-    fig = Figure(figsize=(width * panels, 4.0), dpi=120, layout="constrained")
-    return fig, [fig.add_subplot(1, panels, i + 1) for i in range(panels)]
+    def layout(page):
+        if hasattr(page, "set_layout_engine"):
+            page.set_layout_engine("constrained")
+        return list(np.ravel(page.subplots(1, count)))
+
+    fig, axes, _ = panels(ax, count, layout, figsize=(width * count, 4.0))
+    return fig, axes
 
 
 def _x_values(table, key: str) -> list:
@@ -132,7 +138,9 @@ def _weights(table, key: str, ax):
 
 
 def plot_sweep(table, kind: str | None = None, ax=None):
-    """The study's figure from a sweep table (``uamopt.sweep(...)`` or ``results.parquet``)."""
+    """The study's figure from a sweep table (``uamopt.sweep(...)`` or ``results.parquet``);
+    ``ax`` as in :mod:`uamopt.plotting` (None, a Figure, one Axes: the first panel, or one Axes
+    per panel). Returns the Figure."""
     from uamopt.errors import UamoptError
 
     swept = [c for c in table.columns[1:] if "." in c]
@@ -161,7 +169,9 @@ def save_sweep_figure(table, spec, path: str | Path) -> Path:
     """Draw ``spec.figure`` from ``table`` into ``path`` (PNG, written atomically)."""
     from uamopt.experiments.store import atomic_write
 
+    from uamopt.plotting.style import DPI
+
     fig = plot_sweep(table, spec.figure)
     fig.suptitle(f"{spec.name}{' (small)' if spec.small else ''}: {len(spec.cases)} cases", fontsize=10)
-    atomic_write(Path(path), lambda p: fig.savefig(p, format="png"))
+    atomic_write(Path(path), lambda p: fig.savefig(p, format="png", dpi=DPI))
     return Path(path)

@@ -20,6 +20,8 @@ function                      draws                                             
 :func:`pareto`                the risk–transport front of Fig. 21                 1
 :func:`gantt`                 one schedule per aircraft (Eqs. 24–28)              1
 :func:`delays`                delay per flight and solver (Fig. 19)               1
+:func:`sweep`                 a sensitivity study from results.parquet (Sec. 6.3)  1–4
+:func:`performance_profile`   Dolan–Moré profile of a benchmark table             1
 ============================  ==================================================  =========
 
 Importing this package in Jupyter lets a returned Figure display as a PNG without pyplot
@@ -29,6 +31,8 @@ Importing this package in Jupyter lets a returned Figure display as a PNG withou
 helpers are public in :mod:`uamopt.plotting.style` and :mod:`uamopt.plotting.geometry`.
 """
 
+from uamopt.experiments.bench_report import plot_performance_profile as performance_profile
+from uamopt.experiments.figures import plot_sweep as sweep
 from uamopt.plotting.network import network
 from uamopt.plotting.risk import risk, risk_components
 from uamopt.plotting.schedule import delays, gantt
@@ -46,4 +50,5 @@ def _running_shell():
 
 show_figures_in(_running_shell())
 
-__all__ = ["DPI", "delays", "gantt", "network", "pareto", "risk", "risk_components", "save", "tracks"]
+__all__ = ["DPI", "delays", "gantt", "network", "pareto", "performance_profile", "risk", "risk_components", "save",
+           "sweep", "tracks"]

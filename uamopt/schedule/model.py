@@ -222,10 +222,14 @@ class Schedule:
         return frame.set_index("flight")
 
     def summary(self) -> dict:
-        """The keys of summary.json (docs/interfaces.md)."""
+        """The keys of summary.json (docs/interfaces.md), plus ``model`` (what the status and bound
+        are about, e.g. a delay grid), ``continuous_bound`` (a bound valid for continuous delays) and
+        ``optimal_within`` (objective − continuous_bound) when the solver gives them."""
+        named = {key: self.extras[key] for key in ("model", "continuous_bound", "continuous_bound_model", "optimal_within")
+                 if key in self.extras}
         return {
             "solver": self.solver, "status": self.status, "objective": self.objective, "bound": self.bound,
-            "gap": self.gap, "operated": self.operated_count, "cancelled": self.cancelled,
+            "gap": self.gap, **named, "operated": self.operated_count, "cancelled": self.cancelled,
             "total_delay_s": self.total_delay_s, "avg_delay_s": self.avg_delay_s,
             "solve_seconds": self.solve_seconds, "seed": self.seed,
         }

@@ -4,7 +4,7 @@ A solver never builds the model: it takes a :class:`~uamopt.schedule.SchedulingP
 and returns a :class:`~uamopt.schedule.Schedule` (status, objective, bound, gap, time, seed).
 Profiles are TOML files in ``solvers/`` naming a solver and its options::
 
-    solver = "highs"        # greedy | ga | soa | highs | cpsat | rolling
+    solver = "highs"        # greedy | ga | soa | highs | cpsat | rolling | timeindexed
     time_limit_s = 60.0
     seed = 0
     threads = 2
@@ -33,6 +33,7 @@ SOLVERS = {
     "highs": "uamopt.solvers.milp",
     "cpsat": "uamopt.solvers.cpsat",
     "rolling": "uamopt.solvers.rolling",
+    "timeindexed": "uamopt.solvers.timeindexed",
 }
 PROFILE_DIR = Path(__file__).resolve().parents[2] / "solvers"
 _KEYS = {"solver", "time_limit_s", "seed", "threads", "options", "description"}
@@ -88,7 +89,7 @@ def load_profile(name_or_path: str | Path) -> SolverProfile:
         raise ScenarioError(f"invalid value in solver profile: {exc}", str(path), "see uamopt/solvers/__init__.py") from None
 
 
-def solve(problem: "SchedulingProblem", profile: SolverProfile | str) -> "Schedule":
+def solve(problem: SchedulingProblem, profile: SolverProfile | str) -> Schedule:
     """Run the profile's solver on the problem."""
     if not isinstance(profile, SolverProfile):
         profile = load_profile(profile)

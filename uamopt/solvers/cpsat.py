@@ -31,20 +31,19 @@ CP-SAT's bound mapped back, a bound of the *discretised* model (``extras["bound_
 Profile options: ``time_unit_s`` (default 0.01); ``threads`` → ``num_workers``, ``seed`` →
 ``random_seed``, ``time_limit_s`` → ``max_time_in_seconds``; other options are CP-SAT parameters
 (a list extends a repeated one). Defaults: ``linearization_level = 2`` with one thread,
-``subsolvers = ["max_lp", "default_lp"]`` with more (see ``solve_here``).
+``subsolvers = ["max_lp", "default_lp"]`` with more (see ``solve``).
 """
 
 from __future__ import annotations
 
-import functools
 import math
 from fractions import Fraction
 
 import numpy as np
 
 from uamopt.errors import UamoptError
+from uamopt.schedule.flights import TIME_TOL_S
 from uamopt.schedule.model import Schedule, SchedulingProblem, make_schedule
-from uamopt.solvers.milp import native_loaded, serve, solve_isolated
 
 ROUND_S = 1e-9  # float round-off accepted when rounding a real time to units, s
 INT_LIMIT = 2**62  # keep |objective| below this (CP-SAT uses int64)
@@ -65,8 +64,12 @@ def _objective(problem: SchedulingProblem, unit_s: float, delay_max: np.ndarray)
     return round(float(per_unit) / top * 1e9), round(float(per_flight) / top * 1e9), 1e9 / top, "approximate"
 
 
-def build_cpsat(problem: SchedulingProblem, unit_s: float = 0.01):
-    """The CP-SAT model; returns (model, operate vars, delay vars in units, per-unit coef, per-flight coef, divisor, how)."""
+def build_cpsat(problem: SchedulingProblem, unit_s: float = 0.01, rounding: str = "outer"):
+    """The CP-SAT model; returns (model, operate vars, delay vars in units, per-unit coef, per-flight coef, divisor, how).
+
+    ``rounding = "inner"`` reads k as the *cell* [k u, (k+1) u) of a continuous delay and forbids
+    only what every point of a cell pair breaks (as timeindexed.py's ``relaxed`` model): a
+    relaxation, whose bound holds for continuous delays."""
     from ortools.sat.python import cp_model  # imported on use: see ``solve``
     from ortools.util.python.sorted_interval_list import Domain
 
@@ -84,15 +87,22 @@ def build_cpsat(problem: SchedulingProblem, unit_s: float = 0.01):
     for chain in problem.chains:
         for i, e in enumerate(chain.tolist()):
             for f in chain[i + 1:].tolist():
-                need = math.ceil((dep[e] + time[e] + gap[e] - dep[f]) / unit_s - eta)
+                need = dep[e] + time[e] + gap[e] - dep[f]
+                need = (math.ceil(need / unit_s - eta) if rounding == "outer"
+                        else math.floor((need - TIME_TOL_S) / unit_s - 1 - eta) + 1)
                 if need > -delay_max[e]:
                     model.add(delay[f] - delay[e] >= need).only_enforce_if([operate[e], operate[f]])
     pairs, ptr, intervals = problem.conflict_arrays
     for k, (p, q) in enumerate(pairs.tolist()):
         shift = dep[q] - dep[p]
         reach = Domain(-int(delay_max[p]), int(delay_max[q]))
-        forbidden = [[math.floor((lo - shift) / unit_s + eta) + 1, math.ceil((hi - shift) / unit_s - eta) - 1]
-                     for lo, hi in intervals[ptr[k]:ptr[k + 1]].tolist()]
+        if rounding == "outer":
+            forbidden = [[math.floor((lo - shift) / unit_s + eta) + 1, math.ceil((hi - shift) / unit_s - eta) - 1]
+                         for lo, hi in intervals[ptr[k]:ptr[k + 1]].tolist()]
+        else:
+            forbidden = [[math.ceil((lo + TIME_TOL_S - shift) / unit_s + 1 + eta),
+                          math.floor((hi - TIME_TOL_S - shift) / unit_s - 1 - eta)]
+                         for lo, hi in intervals[ptr[k]:ptr[k + 1]].tolist()]
         forbidden = [iv for iv in forbidden if iv[0] <= iv[1]]
         allowed = reach.intersection_with(Domain.from_intervals(forbidden).complement()) if forbidden else reach
         if allowed.is_empty():
@@ -113,47 +123,17 @@ def _bound(problem: SchedulingProblem, raw: float, per_flight: int, divisor: flo
     return s0 + unit_s * max(0.0, raw - per_flight * s0) / (float(np.sum(problem.delay_upper_s)) + 1.0)
 
 
-def solve(problem: SchedulingProblem, profile) -> Schedule:
-    """Solve the discretised model with CP-SAT; status optimal | feasible | time_limit | infeasible.
-
-    OR-Tools bundles its own libhighs.so.1, which may clash with highspy's: when OR-Tools fails
-    to import because highspy is loaded here, CP-SAT runs in a worker process
-    (``milp.solve_isolated``).
-    """
-    if not _importable_here():
-        if native_loaded("highspy"):
-            return solve_isolated(__name__, problem, profile)
-        raise UamoptError("OR-Tools is not installed", f"profile {profile.name or 'cpsat'}", "pip install ortools")
-    return solve_here(problem, profile)
-
-
-@functools.cache
-def _importable_here() -> bool:
-    """Whether OR-Tools imports in this process; asked once (a failed try costs ~0.1 s, and a
-    loaded highspy stays loaded)."""
-    try:
-        from ortools.sat.python import cp_model  # noqa: F401
-    except ImportError:
-        return False
-    return True
-
-
-def solve_here(problem: SchedulingProblem, profile) -> Schedule:
-    """:func:`solve` in this process."""
+def _solver(profile, options: dict, limit_s: float):
+    """A CpSolver with the profile's limit, threads, seed and options."""
     from ortools.sat.python import cp_model
 
-    options = dict(profile.options)
-    unit_s = float(options.pop("time_unit_s", 0.01))
-    if not (math.isfinite(unit_s) and unit_s > 0):
-        raise UamoptError(f"time_unit_s must be a positive number of seconds, got {unit_s}",
-                          f"profile {profile.name or 'cpsat'}", "use e.g. 0.01")
-    model, operate, delay, _, per_flight, divisor, how = build_cpsat(problem, unit_s)
     solver = cp_model.CpSolver()
-    solver.parameters.max_time_in_seconds = float(profile.time_limit_s)
+    solver.parameters.max_time_in_seconds = float(limit_s)
     solver.parameters.num_workers = int(profile.threads)
     solver.parameters.random_seed = int(profile.seed)
     # CP-SAT's default small portfolios carry no max-LP worker and cannot close the bound of the
     # paper case in 60 s; with the big-M linear relaxation (level 2) they prove it in about 1 s
+    options = dict(options)
     if int(profile.threads) == 1:
         options.setdefault("linearization_level", 2)
     else:
@@ -167,31 +147,74 @@ def solve_here(problem: SchedulingProblem, profile) -> Schedule:
         except (AttributeError, TypeError, ValueError) as exc:
             raise UamoptError(f"unknown or invalid CP-SAT option '{key}': {exc}", f"profile {profile.name or 'cpsat'}",
                               "see ortools/sat/sat_parameters.proto") from None
+    return solver
+
+
+def solve(problem: SchedulingProblem, profile) -> Schedule:
+    """Solve the discretised model with CP-SAT; status optimal | time_limit | infeasible, from CP-SAT's
+    own termination (OPTIMAL: proved on the u-lattice model; FEASIBLE: stopped by the time limit,
+    the only limit set). Hinted with the best cheap heuristic schedule on the ΔT_a grid
+    (:mod:`~uamopt.solvers.warmstart`), and never worse than it.
+
+    Then (option ``continuous_bound``, default true) the ``inner`` model (cells of width u, a
+    relaxation) is solved, hinted with that solution, for the rest of the time limit (at least
+    1 s): its bound L is valid for continuous delays, so OPT ∈ [L, objective] and the summary gives
+    ``continuous_bound`` = L and ``optimal_within`` = objective − L (an ε proved on this instance;
+    no a-priori ε exists, since a feasible window narrower than u may hold no lattice point).
+    """
+    import time
+
+    from ortools.sat.python import cp_model
+
+    from uamopt.solvers.warmstart import no_worse, reduced, warm_start
+
+    options = dict(profile.options)
+    unit_s = float(options.pop("time_unit_s", 0.01))
+    want_bound = bool(options.pop("continuous_bound", True))
+    if not (math.isfinite(unit_s) and unit_s > 0):
+        raise UamoptError(f"time_unit_s must be a positive number of seconds, got {unit_s}",
+                          f"profile {profile.name or 'cpsat'}", "use e.g. 0.01")
+    t0 = time.perf_counter()
+    small = reduced(problem)  # dominance caps (warmstart.py): the same optima
+    model, operate, delay, _, per_flight, divisor, how = build_cpsat(small, unit_s)
+    start = warm_start(problem, seed=profile.seed, on_grid=True)
+    for f in range(problem.n_flights):
+        model.add_hint(operate[f], bool(start.operated[f]))
+        model.add_hint(delay[f], int(np.rint(start.delay_s[f] / unit_s)) if start.operated[f] else 0)
+    solver = _solver(profile, options, profile.time_limit_s)
     code = solver.solve(model)
     seconds = float(solver.wall_time)
     n = problem.n_flights
     extras = {"termination": solver.status_name(code), "time_unit_s": unit_s, "objective_scale": how,
-              "bound_of": "time-discretised model", "branches": int(solver.num_branches)}
+              "model": f"delay lattice {unit_s:g} s, constraints rounded outward (a restriction of the continuous model)",
+              "branches": int(solver.num_branches), "warm_start": f"{start.source} {start.objective:.6f}"}
     if code == cp_model.MODEL_INVALID:
         raise UamoptError(f"CP-SAT rejected the model: {model.validate()}", f"profile {profile.name or 'cpsat'}",
                           "report this as a bug")
     if code == cp_model.INFEASIBLE:
         return make_schedule(problem, "cpsat", "infeasible", np.zeros(n, bool), np.zeros(n), solve_seconds=seconds,
                              seed=profile.seed, extras=extras)
-    if code == cp_model.UNKNOWN:  # no incumbent before the limit: cancelling every flight is always feasible
-        extras["incumbent"] = "none found: every flight cancelled"
-        return make_schedule(problem, "cpsat", "time_limit", np.zeros(n, bool), np.zeros(n), solve_seconds=seconds,
-                             seed=profile.seed, extras=extras)
+    if code == cp_model.UNKNOWN:  # no incumbent before the limit: the warm start
+        return no_worse(problem, make_schedule(problem, "cpsat", "time_limit", np.zeros(n, bool), np.zeros(n),
+                                               solve_seconds=seconds, seed=profile.seed, extras=extras), start)
     operated = np.array([solver.boolean_value(v) for v in operate])
-    delay_s = np.array([solver.value(v) for v in delay], dtype=float) * unit_s
-    if code == cp_model.OPTIMAL:
-        status = "optimal"
-    else:
-        status = "time_limit" if seconds >= 0.99 * profile.time_limit_s else "feasible"
+    delay_k = [solver.value(v) for v in delay]
+    delay_s = np.array(delay_k, dtype=float) * unit_s
+    status = "optimal" if code == cp_model.OPTIMAL else "time_limit"  # FEASIBLE: stopped by the time limit
     bound = _bound(problem, solver.best_objective_bound, per_flight, divisor, unit_s, how)
-    return make_schedule(problem, "cpsat", status, operated, delay_s, bound=bound, solve_seconds=seconds,
-                         seed=profile.seed, extras=extras)
-
-
-if __name__ == "__main__":
-    serve(solve_here)
+    schedule = no_worse(problem, make_schedule(problem, "cpsat", status, operated, delay_s, bound=bound,
+                                               solve_seconds=seconds, seed=profile.seed, extras=extras), start)
+    if want_bound:
+        inner, i_op, i_delay, _, i_flight, i_div, i_how = build_cpsat(small, unit_s, rounding="inner")
+        for f in range(n):  # the outer solution is a point of the relaxation
+            inner.add_hint(i_op[f], bool(operated[f]))
+            inner.add_hint(i_delay[f], int(delay_k[f]))
+        left = max(1.0, profile.time_limit_s - (time.perf_counter() - t0))
+        relaxed = _solver(profile, options, left)
+        r_code = relaxed.solve(inner)
+        if r_code in (cp_model.OPTIMAL, cp_model.FEASIBLE, cp_model.UNKNOWN):
+            low = _bound(problem, relaxed.best_objective_bound, i_flight, i_div, unit_s, i_how)
+            schedule.extras.update(continuous_bound=low, continuous_bound_termination=relaxed.status_name(r_code),
+                                   continuous_bound_model=f"delay cells {unit_s:g} s (relaxation of the continuous model)",
+                                   optimal_within=schedule.objective - low)
+    return schedule

@@ -34,14 +34,6 @@ Profile options: ``mip_rel_gap`` (default 0.0); every other key goes to HiGHS un
 
 from __future__ import annotations
 
-import atexit
-import os
-import pickle
-import subprocess
-import sys
-from importlib.machinery import EXTENSION_SUFFIXES
-from pathlib import Path
-
 import numpy as np
 import pyomo.environ as pyo
 from pyomo.contrib.solver.common.factory import SolverFactory
@@ -194,31 +186,54 @@ def _choices(m: pyo.ConcreteModel, operated: np.ndarray) -> dict[int, tuple[floa
     return chosen
 
 
+def mip_start(m: pyo.ConcreteModel, problem: SchedulingProblem, operated: np.ndarray, delay_s: np.ndarray) -> dict:
+    """Values of every variable of ``build_model`` for a feasible schedule (a MIP start), keyed by
+    ``id(var)``: c, d, and y = 1 on the admissible gap that holds δ for each operated pair (else 0)."""
+    values = {}
+    for f in range(problem.n_flights):
+        values[id(m.operate[f])] = float(operated[f])
+        values[id(m.delay[f])] = float(delay_s[f]) if operated[f] else 0.0
+    dep = problem.planned_departure_s + np.where(operated, delay_s, 0.0)
+    for k, (p, q, gaps, _, _) in enumerate(m.gaps_of):
+        if len(gaps) < 2:
+            continue
+        pick = -1
+        if operated[p] and operated[q]:
+            delta = dep[q] - dep[p]
+            pick = min(range(len(gaps)), key=lambda j: max(gaps[j][0] - delta, delta - gaps[j][1], 0.0))
+        for j in range(len(gaps)):
+            values[id(m.in_gap[k, j])] = float(j == pick)
+    return values
+
+
 def solve(problem: SchedulingProblem, profile) -> Schedule:
     """Build and solve the MILP with HiGHS; a linopy-style status, never an exception on a limit.
 
     Status: ``optimal`` (proved, within ``mip_rel_gap``), ``time_limit`` (limit hit; the incumbent
-    with HiGHS's bound, or all flights cancelled if HiGHS found none), ``infeasible``.
-    Runs in a worker process when highspy cannot load here because OR-Tools' copy of HiGHS
-    already is (see the end of this module).
+    with HiGHS's bound), ``infeasible``. HiGHS starts from the best cheap heuristic schedule
+    (:func:`~uamopt.solvers.warmstart.warm_start`, a MIP start through ``Highs.setSolution``) and
+    never returns a worse one (:func:`~uamopt.solvers.warmstart.no_worse`). The model is built on
+    :func:`~uamopt.solvers.warmstart.reduced` (dominated delays cut off; the optima are unchanged).
     """
-    solver = SolverFactory(SOLVER_NAME)
-    if (solver is None or not solver.available()) and native_loaded("ortools"):
-        return solve_isolated(__name__, problem, profile)
-    return solve_here(problem, profile)
+    from uamopt.solvers.warmstart import no_worse, reduced, warm_start
 
-
-def solve_here(problem: SchedulingProblem, profile) -> Schedule:
-    """:func:`solve` in this process."""
     options = dict(profile.options)
     options.setdefault("mip_rel_gap", 0.0)
     options.setdefault("random_seed", int(profile.seed))
-    m = build_model(problem)
+    start = warm_start(problem, seed=profile.seed)
+    m = build_model(reduced(problem))  # delay bounds capped by dominance: the same optima (warmstart.py)
     solver = SolverFactory(SOLVER_NAME)
     if solver is None or not solver.available():
         raise UamoptError("HiGHS is not available to Pyomo", f"solver {profile.name or 'highs'}", "pip install highspy")
+    solver.set_instance(m)  # the persistent interface: load the model, then hand HiGHS the MIP start
+    _set_mip_start(solver, mip_start(m, problem, start.operated, start.delay_s))
     result = solver.solve(m, time_limit=float(profile.time_limit_s), threads=int(profile.threads), solver_options=options,
                           load_solutions=False, raise_exception_on_nonoptimal_result=False)
+    if _stale_solution(m, result):  # highspy 1.16: the start's values beside a better objective; solve cold
+        m = build_model(reduced(problem))
+        result = SolverFactory(SOLVER_NAME).solve(m, time_limit=float(profile.time_limit_s), threads=int(profile.threads),
+                                                  solver_options=options, load_solutions=False,
+                                                  raise_exception_on_nonoptimal_result=False)
     tc, has_solution = result.termination_condition, result.solution_status in (SolutionStatus.optimal, SolutionStatus.feasible)
     seconds = float(result.timing_info.wall_time or 0.0)
     extras = {"termination": tc.name, "nodes": getattr(result.extra_info, "mip_node_count", None),
@@ -244,73 +259,37 @@ def solve_here(problem: SchedulingProblem, profile) -> Schedule:
         delay = polished if polished is not None else np.where(operated, raw, 0.0)
     else:
         extras["incumbent"] = "none found: every flight cancelled"
-    return make_schedule(problem, "highs", status, operated, delay, bound=bound, solve_seconds=seconds,
-                         seed=profile.seed, extras=extras)
+    extras["warm_start"] = f"{start.source} {start.objective:.6f}"
+    extras["model"] = "continuous delays (the exact MILP of Eqs. 20-31)"
+    return no_worse(problem, make_schedule(problem, "highs", status, operated, delay, bound=bound, solve_seconds=seconds,
+                                           seed=profile.seed, extras=extras), start)
 
 
-# --- Two HiGHS builds in one process -------------------------------------------------------
-# highspy 1.15.1 and ortools 9.15 each ship a libhighs.so.1 (ortools bundles HiGHS 1.12.0). The
-# dynamic loader keeps the first one loaded, and the other package then fails to import
-# ("undefined symbol"; a failed dlopen leaves nothing behind). So a solver whose package fails
-# to import while the other one is loaded runs in a worker: a child interpreter per solver
-# module, started on first need and reused, which reads pickled (problem, profile) and writes
-# back the pickled Schedule. With matching builds (highspy 1.12.0 beside ortools 9.15) both
-# import in one process and no worker is started.
-
-_WORKERS: dict[str, subprocess.Popen] = {}
+def _stale_solution(m: pyo.ConcreteModel, result) -> bool:
+    """Whether the solution HiGHS hands back does not have the objective it reports."""
+    if result.solution_status not in (SolutionStatus.optimal, SolutionStatus.feasible) or result.incumbent_objective is None:
+        return False
+    result.solution_loader.load_vars()
+    return abs(pyo.value(m.objective) - result.incumbent_objective) > 1e-6 * (1.0 + abs(result.incumbent_objective))
 
 
-def native_loaded(package: str) -> bool:
-    """Whether a compiled extension of ``package`` (``"highspy"``, ``"ortools"``) is loaded here."""
-    return any(name.partition(".")[0] == package and str(getattr(mod, "__file__", "")).endswith(tuple(EXTENSION_SUFFIXES))
-               for name, mod in list(sys.modules.items()))
+def _set_mip_start(solver, values: dict) -> None:
+    """``Highs.setSolution`` on the persistent Pyomo interface's HiGHS model (pyomo 6.10: the column
+    of a variable is ``_pyomo_var_to_solver_var_map[id(var)]``). Without that map (another Pyomo
+    version) HiGHS starts cold; :func:`no_worse` still guards the result."""
+    import highspy
 
-
-def solve_isolated(module: str, problem: SchedulingProblem, profile) -> Schedule:
-    """``module.solve_here(problem, profile)`` in the module's worker process."""
-    worker = _WORKERS.get(module)
-    if worker is None or worker.poll() is not None:
-        root = str(Path(__file__).resolve().parents[2])
-        env = dict(os.environ, PYTHONPATH=os.pathsep.join(filter(None, [root, os.environ.get("PYTHONPATH")])))
-        worker = _WORKERS[module] = subprocess.Popen([sys.executable, "-m", module], stdin=subprocess.PIPE,
-                                                     stdout=subprocess.PIPE, env=env)
-    try:
-        pickle.dump((problem, profile), worker.stdin)
-        worker.stdin.flush()
-        answer = pickle.load(worker.stdout)
-    except (EOFError, BrokenPipeError, pickle.UnpicklingError) as exc:
-        worker.kill()
-        raise UamoptError(f"the {module} worker process died ({exc!r})", f"solver {profile.name or profile.solver}",
-                          "run the solver alone to see its error") from None
-    if isinstance(answer, BaseException):
-        raise answer
-    return answer
-
-
-@atexit.register
-def _stop_workers() -> None:
-    for worker in _WORKERS.values():
-        if worker.poll() is None:
-            worker.stdin.close()
-            worker.wait(timeout=10)
-
-
-def serve(solve_here) -> None:
-    """A worker's loop: (problem, profile) in on stdin, Schedule (or the exception) out on stdout."""
-    channel = os.fdopen(os.dup(1), "wb")
-    os.dup2(2, 1)  # solver logs printed to stdout must not corrupt the pickle stream
-    while True:
-        try:
-            problem, profile = pickle.load(sys.stdin.buffer)
-        except EOFError:
-            return
-        try:
-            answer = solve_here(problem, profile)
-        except Exception as exc:  # noqa: BLE001 - handed back to the parent, which raises it
-            answer = exc
-        pickle.dump(answer, channel)
-        channel.flush()
-
-
-if __name__ == "__main__":
-    serve(solve_here)
+    index = getattr(solver, "_pyomo_var_to_solver_var_map", None)
+    highs = getattr(solver, "_solver_model", None)
+    if not index or highs is None:
+        return
+    highs.resetGlobalScheduler(True)  # one HiGHS thread pool per process: let this solve set its own thread count
+    x = np.zeros(highs.getNumCol())
+    for var_id, value in values.items():
+        col = index.get(var_id)
+        if col is not None:
+            x[col] = value
+    sol = highspy.HighsSolution()
+    sol.col_value = x.tolist()
+    sol.value_valid = True
+    highs.setSolution(sol)

@@ -65,7 +65,6 @@ from uamopt.schedule.flights import TIME_TOL_S
 from uamopt.schedule.model import Schedule, SchedulingProblem, make_schedule, violations
 from uamopt.schedule.occupancy import ConflictTable
 from uamopt.solvers.greedy import Decoder, check_options, greedy_decisions
-from uamopt.solvers.milp import native_loaded, serve, solve_isolated
 
 KNOWN = {"window_s", "inner", "window_time_limit_s", "time_unit_s", "step_s"}
 
@@ -231,27 +230,14 @@ def _options(profile) -> dict:
 
 
 def solve(problem: SchedulingProblem, profile) -> Schedule:
-    """Rolling horizon; runs in a worker process when the inner solver's package cannot load here
-    (highspy and OR-Tools ship clashing HiGHS builds, see milp.py)."""
-    inner = _options(profile)["inner"]
-    if inner == "cpsat":
-        from uamopt.solvers.cpsat import _importable_here
-        if not _importable_here() and native_loaded("highspy"):
-            return solve_isolated(__name__, problem, profile)
-    else:
-        from pyomo.contrib.solver.common.factory import SolverFactory
+    """Rolling horizon (module docstring); never worse than the whole-problem warm start
+    (:mod:`~uamopt.solvers.warmstart`: greedy, greedy with exact gaps), which it returns instead
+    when the windows end worse (``extras["incumbent"]``)."""
+    from uamopt.solvers.warmstart import no_worse, warm_start
 
-        from uamopt.solvers.milp import SOLVER_NAME
-        solver = SolverFactory(SOLVER_NAME)
-        if (solver is None or not solver.available()) and native_loaded("ortools"):
-            return solve_isolated(__name__, problem, profile)
-    return solve_here(problem, profile)
-
-
-def solve_here(problem: SchedulingProblem, profile) -> Schedule:
-    """:func:`solve` in this process."""
     o = _options(profile)
     start = time.perf_counter()
+    first = warm_start(problem, o["step_s"], seed=profile.seed)
     n = problem.n_flights
     dep0 = problem.planned_departure_s
     order = np.lexsort((np.arange(n), dep0))
@@ -321,9 +307,5 @@ def solve_here(problem: SchedulingProblem, profile) -> Schedule:
     bound = pair_matching_bound(problem)
     status = "time_limit" if stats["unproved"] else "feasible"
     stats["bound_of"] = "pair-matching relaxation (rolling.py docstring)"
-    return make_schedule(problem, "rolling", status, operated, delay, bound=bound,
-                         solve_seconds=time.perf_counter() - start, seed=profile.seed, extras=stats)
-
-
-if __name__ == "__main__":
-    serve(solve_here)
+    return no_worse(problem, make_schedule(problem, "rolling", status, operated, delay, bound=bound,
+                                           solve_seconds=time.perf_counter() - start, seed=profile.seed, extras=stats), first)

@@ -1,0 +1,157 @@
+"""The time-indexed solver (uamopt/solvers/timeindexed.py) and the warm starts of every exact solver.
+
+Checked outside the models:
+- on tiny instances, the ``grid`` model's optimum equals an enumeration of every delay vector on
+  the grid (each checked by ``violations``, the model's constraint check, which shares no code with
+  the 0-1 model), and the ``relaxed`` model's optimum is ≤ the continuous optimum of the
+  brute-force oracle (bruteforce.py) ≤ the grid optimum;
+- on the paper case, the grid optimum is ≥ the continuous optimum (HiGHS), the relaxed bound ≤ it,
+  and the written schedule passes the independent verifier;
+- every exact solver, stopped almost at once, returns a schedule no worse than the greedy one.
+"""
+
+from __future__ import annotations
+
+import itertools
+import subprocess
+import sys
+from dataclasses import replace
+
+import numpy as np
+import pytest
+from conftest import PAPER_CASE
+from hypothesis import HealthCheck, given, settings
+from strategies import tiny_problems
+
+from uamopt.schedule import (
+    build_problem,
+    evaluate,
+    generate_plan,
+    violations,
+    write_schedule,
+)
+from uamopt.schedule.verify import verify_dir
+from uamopt.solvers import SolverProfile, bruteforce, load_profile, solve
+from uamopt.solvers.greedy import greedy_decisions
+
+OBJ_TOL = 1e-6
+
+
+def grid_enumeration(problem, step_s: float) -> float:
+    """The best objective over every operate/delay vector with delays k·step (the grid problem)."""
+    choices = [[None] + [k * step_s for k in range(int(np.floor(u / step_s + 1e-9)) + 1)] for u in problem.delay_upper_s]
+    best = np.inf
+    for combo in itertools.product(*choices):
+        operated = np.array([c is not None for c in combo])
+        delay = np.array([0.0 if c is None else c for c in combo])
+        value = evaluate(problem, operated, delay)
+        if value < best - 1e-12 and not violations(problem, operated, delay):
+            best = value
+    return best
+
+
+def ti(model="grid", step_s=5.0, engine="highs", **kw) -> SolverProfile:
+    return SolverProfile("timeindexed", time_limit_s=30.0, threads=1, options={"model": model, "step_s": step_s,
+                                                                               "engine": engine, **kw})
+
+
+@settings(max_examples=40, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
+@given(tiny_problems(max_flights=5))
+def test_grid_model_is_exact_on_its_grid_and_relaxed_bounds_the_continuous_optimum(case):
+    _, problem = case
+    step = 5.0  # delays ≤ 20 s: at most 5 grid points and "cancel" per flight
+    expected = grid_enumeration(problem, step)
+    for engine in ("highs", "cpsat", "hybrid"):
+        grid = solve(problem, ti(step_s=step, engine=engine))
+        assert grid.status == "optimal" and violations(problem, grid.operated, grid.delay_s) == []
+        assert grid.objective == pytest.approx(expected, abs=OBJ_TOL)
+        assert grid.bound == pytest.approx(expected, abs=OBJ_TOL)
+    continuous = bruteforce.solve(problem).objective
+    assert continuous <= expected + OBJ_TOL  # the grid restricts the continuous model
+    for step_s in (5.0, 1.0):
+        relaxed = solve(problem, ti(model="relaxed", step_s=step_s))
+        assert relaxed.bound <= continuous + OBJ_TOL
+        assert violations(problem, relaxed.operated, relaxed.delay_s) == []  # the warm start it shows
+
+
+@pytest.fixture(scope="module")
+def paper_problem(paper_straight_plan):
+    scenario, _, _, plan = paper_straight_plan
+    return build_problem(plan, scenario)
+
+
+def test_exact_profile_on_the_paper_case(paper_problem, tmp_path):
+    problem = paper_problem
+    profile = load_profile("exact")
+    assert profile.solver == "timeindexed"
+    grid = solve(problem, profile)
+    continuous = solve(problem, SolverProfile("highs", time_limit_s=60.0, threads=2))
+    print(f"\ngrid: {grid.summary()}\ncontinuous: {continuous.summary()}")
+    assert grid.status == "optimal" and grid.gap <= 1e-6 and continuous.status == "optimal"
+    assert grid.objective >= continuous.objective - OBJ_TOL  # a restriction: never below the continuous optimum
+    write_schedule(tmp_path, problem, grid)
+    assert verify_dir(tmp_path) == []
+    summary = grid.summary()
+    assert summary["model"].startswith("delay grid 10 s") and summary["status"] == "optimal"
+    relaxed = solve(problem, ti(model="relaxed", step_s=10.0))
+    assert relaxed.bound <= continuous.objective + OBJ_TOL
+    assert relaxed.summary()["model"].startswith("delay cells 10 s (relaxation")
+
+
+@pytest.fixture(scope="module")
+def medium_problem(paper_straight_plan):
+    scenario, _, network, _ = paper_straight_plan
+    return build_problem(generate_plan(scenario, network, seed=1, aircraft=40), scenario)
+
+
+@pytest.mark.parametrize("profile", [
+    SolverProfile("highs", time_limit_s=0.05, threads=1),
+    SolverProfile("cpsat", time_limit_s=0.05, threads=1),
+    SolverProfile("rolling", time_limit_s=0.05, threads=1, options={"window_s": 900.0}),
+    SolverProfile("timeindexed", time_limit_s=0.05, threads=1),
+    SolverProfile("timeindexed", time_limit_s=0.05, threads=1, options={"engine": "cpsat"}),
+    SolverProfile("timeindexed", time_limit_s=0.05, threads=1, options={"engine": "hybrid"}),
+], ids=["highs", "cpsat", "rolling", "timeindexed-highs", "timeindexed-cpsat", "timeindexed-hybrid"])
+def test_exact_solvers_never_worse_than_greedy_at_a_tiny_limit(medium_problem, profile, tmp_path):
+    problem = medium_problem
+    greedy = evaluate(problem, *greedy_decisions(problem))
+    schedule = solve(problem, profile)
+    print(f"\n{profile.solver}: {schedule.status} {schedule.objective:.4f} (greedy {greedy:.4f}) {schedule.extras.get('incumbent')}")
+    assert schedule.objective <= greedy + 1e-9
+    assert schedule.status in ("time_limit", "optimal")
+    write_schedule(tmp_path, problem, schedule)
+    assert verify_dir(tmp_path) == []
+
+
+def test_relaxed_model_rejects_bad_options(paper_problem):
+    with pytest.raises(Exception, match="unknown time-indexed model"):
+        solve(paper_problem, ti(model="loose"))
+    with pytest.raises(Exception, match="unknown option 'bogus'"):
+        solve(paper_problem, replace(ti(), options={"bogus": 1}))
+
+
+def test_highs_and_cpsat_in_one_process_either_order(root):
+    """highspy 1.16.0 links HiGHS statically, so OR-Tools' bundled libhighs.so.1 cannot clash with it:
+    both solvers load and solve in one interpreter, whichever is imported first (pyproject.toml)."""
+    script = (
+        "import sys\n"
+        "from uamopt.scenario import load_scenario\n"
+        "from uamopt.grid import AirspaceGrid\n"
+        "from uamopt.schedule import build_problem, generate_plan, straight_network\n"
+        "from uamopt.solvers import SolverProfile, solve\n"
+        f"sc = load_scenario({str(PAPER_CASE)!r})\n"
+        "grid = AirspaceGrid.from_extent(sc.grid.cell, sc.grid.extent)\n"
+        "pb = build_problem(generate_plan(sc, straight_network(sc, grid), seed=0, aircraft=4), sc)\n"
+        "names = sys.argv[1].split(',')\n"
+        "res = [solve(pb, SolverProfile(n, time_limit_s=30)) for n in names]\n"
+        "loaded = sorted({m.split('.')[0] for m in sys.modules if m in ('highspy._core', 'ortools.sat.python.cp_model_helper')})\n"
+        "print(' '.join(r.status for r in res), res[0].objective - res[1].objective, ','.join(loaded))\n"
+    )
+    for order in ("cpsat,highs", "highs,cpsat"):
+        out = subprocess.run([sys.executable, "-c", script, order], check=False, capture_output=True, text=True, cwd=root,
+                             timeout=120)
+        assert out.returncode == 0, out.stderr
+        status_a, status_b, difference, loaded = out.stdout.split()[-4:]
+        assert status_a == status_b == "optimal" and loaded == "highspy,ortools"
+        sign = 1.0 if order.startswith("cpsat") else -1.0  # CP-SAT's lattice optimum is ≥ the continuous one
+        assert -OBJ_TOL <= sign * float(difference) <= 0.1

@@ -1,0 +1,399 @@
+"""Solver ``timeindexed``: the scheduling model of Sec. 4.3 on a delay grid, as a 0-1 program.
+
+Model (one step s, the paper's ΔT_a = 10 s by default)
+-------------------------------------------------------
+Binary x_{f,k} = 1: flight f operates with delay index k ∈ {0, …, K_f}, K_f = ⌊U_f / s⌋ (Eqs. 26,
+29); all x_{f,·} = 0 cancels f. Rows:
+
+- assignment    Σ_k x_{f,k} ≤ 1 (c_f = Σ_k x_{f,k});
+- precedence    Σ_k x_{f,k} ≤ Σ_k x_{r,k}, r = requires[f]: a cancelled outbound cancels its return;
+- pair rows     for a pair (p, q) whose index difference z = k_q − k_p may not lie in a set Z
+  (a union of integer intervals): for every a, x_{p,a} + Σ_{b ∈ a + Z} x_{q,b} ≤ 1 — the
+  *aggregated* conflict inequality, exact for 0-1 points because Σ_b x_{q,b} ≤ 1, and far tighter
+  in the LP than big-M rows. Pairs are (i) every conflicting pair of ``problem.conflicts`` (its
+  forbidden open intervals (lo, hi) of δ = dep_q − dep_p, read from ``conflict_arrays``) and
+  (ii) every ordered pair e before f of one aircraft (turnaround, Eqs. 27-28: dep_f − dep_e ≥
+  A_ef = T_e + ΔT_e with both operated; the all-pairs form is exact, model.py);
+- objective     Σ_{f,k} (w_d · k s − w_c) x_{f,k}: Eq. 20 (w_d = ω6/G, w_c = ω7) or the
+  lexicographic scalar (w_d = 1/(ΣU + 1), w_c = 1).
+
+Two readings of Z, with ΔD = D_q − D_p and η = 10⁻⁹ s / s of round-off:
+
+``grid`` — delays *are* k·s (the paper's ΔT_a grid, as its GA/SOA chromosomes). z is forbidden iff
+  lo < ΔD + s z < hi: Z = [⌊(lo − ΔD)/s + η⌋ + 1, ⌈(hi − ΔD)/s − η⌉ − 1]; turnaround forbids
+  z < ⌈(A − ΔD_ef)/s − η⌉. This model is **exact for the grid-restricted problem**: its optimum is
+  the best schedule with delays on the ΔT_a grid, every solution is feasible for the continuous
+  model (Sec. 4.3), and so its optimum is ≥ the continuous optimum (a *restriction*).
+``relaxed`` — k is the grid *cell* of a continuous delay, d ∈ [k s, (k+1) s). A cell pair (a, b)
+  is forbidden only if *every* delay pair in it is: δ then ranges over the open interval
+  (ΔD + s(z − 1), ΔD + s(z + 1)), so z is forbidden iff lo + τ ≤ ΔD + s(z − 1) and
+  ΔD + s(z + 1) ≤ hi − τ (τ = ``TIME_TOL_S``: conservative, forbid less); turnaround forbids z
+  only when s(z + 1) ≤ A − ΔD_ef − τ; the cost of a cell is its lower end k s. Every continuous
+  schedule maps to a feasible point of no greater cost, so this model is a **relaxation of the
+  continuous model**: its optimum (and any bound of it, e.g. its LP) is a valid lower bound for
+  continuous delays. Its solutions are not schedules; only its bound is used.
+
+So  relaxed(s) ≤ continuous optimum ≤ grid(s),  and both gaps close as s → 0.
+
+Delay bounds are first capped by dominance (:func:`~uamopt.solvers.warmstart.reduced`, weighted
+objective: no optimum changes), which shrinks the model several-fold.
+
+Engines: ``engine = "highs"`` (highspy directly; MIP start from :mod:`warmstart` via
+``setSolution``) or ``"cpsat"`` (OR-Tools CP-SAT on the same 0-1 model: at-most-one rows, the
+objective scaled to integers exactly as in cpsat.py; hints from the warm start; pair rows written
+from both sides), ``"hybrid"`` (HiGHS without presolve for ``HYBRID_HIGHS_SHARE`` of the time —
+it finds good incumbents fast — then CP-SAT hinted with HiGHS's best, whose clique-merged LP gives
+the far better bound; the better incumbent and the larger bound of the two, both of this model) or
+``"auto"`` (default: HiGHS up to ``AUTO_HIGHS_COLUMNS`` columns, else hybrid — HiGHS proved the
+300- and 600-flight rungs optimal, but at 1,000 its presolve used the whole 300 s).
+
+Options: ``step_s`` (s, default 10), ``model`` ("grid" | "relaxed", default "grid"), ``engine``
+("auto" | "highs" | "cpsat" | "hybrid", default "auto"), ``warm_soa_s`` (seconds of SOA in the warm start, default 0),
+``continuous_bound_s`` (default 0: seconds to spend after a ``grid`` solve on the ``relaxed``
+model at ``continuous_bound_step_s`` (default ``step_s``), whose bound is reported as
+``extras["continuous_bound"]``), ``mip_rel_gap`` (default 0). The summary names the model:
+``extras["model"]`` = e.g. "delay grid 10 s (exact for delays on the grid)".
+Status: from the engine's own termination — ``optimal`` (proved on the named model),
+``time_limit``; never inferred from elapsed time.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from uamopt.errors import UamoptError
+from uamopt.schedule.flights import TIME_TOL_S
+from uamopt.schedule.model import Schedule, SchedulingProblem, make_schedule
+from uamopt.solvers.greedy import check_options
+from uamopt.solvers.warmstart import Start, no_worse, reduced, warm_start
+
+KNOWN = {"step_s", "model", "engine", "warm_soa_s", "continuous_bound_s", "continuous_bound_step_s", "mip_rel_gap"}
+ETA_S = 1e-9  # float round-off accepted when rounding a time to grid steps, s
+AUTO_HIGHS_COLUMNS = 8000  # engine "auto": HiGHS up to this many columns, "hybrid" above
+HYBRID_HIGHS_SHARE = 0.3  # engine "hybrid": this share of the time to HiGHS (no presolve), the rest to CP-SAT
+
+
+@dataclass(frozen=True)
+class GridModel:
+    """The 0-1 model as arrays (module docstring). Column of (f, k): ``start[f] + k``."""
+
+    step_s: float
+    kind: str  # "grid" | "relaxed"
+    start: np.ndarray  # (n + 1,) first column of each flight
+    cost: np.ndarray  # (N,) objective coefficient per column
+    row_ptr: np.ndarray  # pair and assignment rows (all "≤ 1", coefficients 1): CSR
+    row_col: np.ndarray
+    prec: np.ndarray  # (m, 2): (f, r) with Σ x_f ≤ Σ x_r
+
+    @property
+    def n_cols(self) -> int:
+        return int(self.start[-1])
+
+    @property
+    def n_rows(self) -> int:
+        return len(self.row_ptr) - 1 + len(self.prec)
+
+    def columns_of(self, operated: np.ndarray, delay_s: np.ndarray) -> np.ndarray | None:
+        """The 0-1 vector of a schedule whose delays are on the grid, or None if one is not."""
+        k = np.rint(delay_s / self.step_s).astype(np.int64)
+        on = np.asarray(operated, dtype=bool)
+        if np.any(on & (np.abs(k * self.step_s - delay_s) > 1e-6)) or np.any(on & (k > np.diff(self.start) - 1)):
+            return None
+        x = np.zeros(self.n_cols)
+        x[self.start[:-1][on] + k[on]] = 1.0
+        return x
+
+    def decode(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Operated flags and delays k·s of a 0-1 vector."""
+        n = len(self.start) - 1
+        col = np.flatnonzero(np.asarray(x) > 0.5)
+        flight = np.searchsorted(self.start, col, side="right") - 1
+        operated, delay = np.zeros(n, dtype=bool), np.zeros(n)
+        operated[flight] = True
+        delay[flight] = (col - self.start[flight]) * self.step_s
+        return operated, delay
+
+
+def _forbidden_steps(problem: SchedulingProblem, step_s: float, kind: str, k_max: np.ndarray):
+    """(p, q, z_lo, z_hi): the integer intervals of forbidden z = k_q − k_p, conflicts then turnarounds."""
+    eta = ETA_S / step_s
+    dep, s = problem.planned_departure_s, step_s
+    pairs, ptr, intervals = problem.conflict_arrays
+    row_pair = np.repeat(np.arange(len(pairs)), np.diff(ptr))
+    p, q = pairs[row_pair, 0], pairs[row_pair, 1]
+    shift = dep[q] - dep[p]
+    lo, hi = intervals[:, 0] - shift, intervals[:, 1] - shift
+    if kind == "grid":
+        z_lo, z_hi = np.floor(lo / s + eta) + 1, np.ceil(hi / s - eta) - 1
+    else:
+        z_lo, z_hi = np.ceil((lo + TIME_TOL_S) / s + 1 + eta), np.floor((hi - TIME_TOL_S) / s - 1 - eta)
+    tp, tq, need = [], [], []
+    time_, gap = problem.flight_time_s, problem.turnaround_after_s
+    for chain in problem.chains:
+        for i, e in enumerate(chain.tolist()):
+            for f in chain[i + 1:].tolist():
+                tp.append(e)
+                tq.append(f)
+                need.append(dep[e] + time_[e] + gap[e] - dep[f])  # k_f s − k_e s must reach it
+    tp, tq, need = np.array(tp, dtype=np.int64), np.array(tq, dtype=np.int64), np.array(need, dtype=float)
+    t_hi = np.ceil(need / s - eta) - 1 if kind == "grid" else np.floor((need - TIME_TOL_S) / s - 1 - eta)
+    p, q = np.concatenate([p, tp]), np.concatenate([q, tq])
+    z_lo = np.concatenate([z_lo, np.full(len(tp), -np.inf)])
+    z_hi = np.concatenate([z_hi, t_hi])
+    # clip to reachable differences z ∈ [−K_p, K_q]; keep non-empty intervals
+    z_lo = np.maximum(z_lo, -k_max[p]).astype(np.int64) if len(p) else z_lo.astype(np.int64)
+    z_hi = np.minimum(z_hi, k_max[q]).astype(np.int64) if len(p) else z_hi.astype(np.int64)
+    keep = z_lo <= z_hi
+    return p[keep], q[keep], z_lo[keep], z_hi[keep]
+
+
+def build_grid_model(problem: SchedulingProblem, step_s: float = 10.0, kind: str = "grid", both_ways: bool = False
+                     ) -> GridModel:
+    """The time-indexed model of the module docstring, vectorised over pairs and delay indices.
+
+    ``both_ways`` also writes each pair's rows from q's side (x_{q,b} + Σ_{a: b − a ∈ Z} x_{p,a} ≤ 1):
+    twice the rows, a tighter relaxation for CP-SAT's propagation and LP."""
+    if kind not in ("grid", "relaxed"):
+        raise UamoptError(f"unknown time-indexed model '{kind}'", "solver timeindexed", "use model = \"grid\" or \"relaxed\"")
+    if not (math.isfinite(step_s) and step_s > 0):
+        raise UamoptError(f"step_s must be positive, got {step_s}", "solver timeindexed", "give the delay grid step in s, e.g. 10")
+    n = problem.n_flights
+    k_max = np.floor(problem.delay_upper_s / step_s + ETA_S / step_s).astype(np.int64)
+    start = np.concatenate([[0], np.cumsum(k_max + 1)]).astype(np.int64)
+    flight_of_col = np.repeat(np.arange(n), k_max + 1)
+    k_of_col = np.arange(start[-1]) - start[flight_of_col]
+    if problem.objective_kind == "lexicographic":
+        per_delay, per_flight = 1.0 / (float(np.sum(problem.delay_upper_s)) + 1.0), 1.0
+    else:
+        per_delay, per_flight = problem.weights[0] / problem.aircraft_count, float(problem.weights[1])
+    cost = per_delay * k_of_col * step_s - per_flight
+    p, q, z_lo, z_hi = _forbidden_steps(problem, step_s, kind, k_max)
+    if both_ways:
+        p, q, z_lo, z_hi = np.concatenate([p, q]), np.concatenate([q, p]), np.concatenate([z_lo, -z_hi]), np.concatenate([z_hi, -z_lo])
+    # one row per (pair interval, a): b ∈ [max(0, a + z_lo), min(K_q, a + z_hi)], then rows merged per (p, q, a)
+    a_count = k_max[p] + 1
+    iv = np.repeat(np.arange(len(p)), a_count)
+    a = np.arange(a_count.sum()) - np.repeat(np.cumsum(a_count) - a_count, a_count)
+    b_lo = np.maximum(0, a + z_lo[iv])
+    b_hi = np.minimum(k_max[q[iv]], a + z_hi[iv])
+    live = b_lo <= b_hi
+    iv, a, b_lo, b_hi = iv[live], a[live], b_lo[live], b_hi[live]
+    width = b_hi - b_lo + 1
+    ent_iv = np.repeat(np.arange(len(iv)), width)
+    b = np.arange(width.sum()) - np.repeat(np.cumsum(width) - width, width) + b_lo[ent_iv]
+    col_q = start[q[iv[ent_iv]]] + b
+    # row key: (p, q, a); one pair may have several intervals (and turnaround + conflict never share a pair)
+    key_row = (p[iv] * n + q[iv]) * (int(k_max.max()) + 1) + a
+    key_ent = key_row[ent_iv]
+    col_p = start[p[iv]] + a
+    packed = np.unique(np.concatenate([key_row, key_ent]) * start[-1] + np.concatenate([col_p, col_q]))  # x_{p,a} once per row
+    row_key, col = np.divmod(packed, start[-1])
+    _, first = np.unique(row_key, return_index=True)
+    pair_ptr = np.append(first, len(packed)).astype(np.int64)
+    # assignment rows Σ_k x_{f,k} ≤ 1 (only for flights with more than one column)
+    multi = np.flatnonzero(k_max > 0)
+    assign_cols = np.concatenate([np.arange(start[f], start[f + 1]) for f in multi]) if len(multi) else np.zeros(0, np.int64)
+    assign_ptr = np.concatenate([[0], np.cumsum(k_max[multi] + 1)]).astype(np.int64)
+    row_ptr = np.concatenate([assign_ptr, assign_ptr[-1] + pair_ptr[1:]])
+    row_col = np.concatenate([assign_cols, col]).astype(np.int64)
+    req = problem.requires
+    prec = np.stack([np.flatnonzero(req >= 0), req[req >= 0]], axis=1).astype(np.int64)
+    return GridModel(step_s=float(step_s), kind=kind, start=start, cost=cost, row_ptr=row_ptr, row_col=row_col, prec=prec)
+
+
+def model_name(kind: str, step_s: float) -> str:
+    """What a bound or an optimum of the model is about (summary.json ``model``)."""
+    if kind == "grid":
+        return f"delay grid {step_s:g} s (exact for delays on the grid; a restriction of the continuous model)"
+    return f"delay cells {step_s:g} s (relaxation of the continuous model; its bound holds for continuous delays)"
+
+
+# --- engines -------------------------------------------------------------------------------------
+@dataclass
+class EngineResult:
+    x: np.ndarray | None  # incumbent 0-1 vector (None: none)
+    bound: float | None
+    proved: bool
+    termination: str
+    seconds: float
+    first_incumbent_s: float | None = None  # s after the engine started (the warm start is ready before)
+    best_incumbent_s: float | None = None
+
+
+def _highs(model: GridModel, limit_s: float, threads: int, seed: int, gap: float, hint: np.ndarray | None,
+           presolve: bool = True) -> EngineResult:
+    import highspy
+
+    h = highspy.Highs()
+    h.resetGlobalScheduler(True)  # HiGHS keeps one thread pool per process: a new thread count needs a new pool
+    h.setOptionValue("output_flag", False)
+    h.setOptionValue("time_limit", float(limit_s))
+    h.setOptionValue("threads", int(threads))
+    h.setOptionValue("random_seed", int(seed))
+    h.setOptionValue("mip_rel_gap", float(gap))
+    if not presolve:  # at 1,000 flights HiGHS's presolve took the whole limit; without it HiGHS finds incumbents fast
+        h.setOptionValue("presolve", "off")
+    n = model.n_cols
+    inf = highspy.kHighsInf
+    h.addVars(n, np.zeros(n), np.ones(n))
+    h.changeColsCost(n, np.arange(n, dtype=np.int32), model.cost)
+    h.changeColsIntegrality(n, np.arange(n, dtype=np.int32), np.full(n, highspy.HighsVarType.kInteger))
+    m = len(model.row_ptr) - 1
+    h.addRows(m, np.full(m, -inf), np.ones(m), len(model.row_col), model.row_ptr[:-1].astype(np.int32),
+              model.row_col.astype(np.int32), np.ones(len(model.row_col)))
+    if len(model.prec):  # Σ x_f − Σ x_r ≤ 0
+        cols, vals, ptr = [], [], [0]
+        for f, r in model.prec.tolist():
+            cols += list(range(model.start[f], model.start[f + 1])) + list(range(model.start[r], model.start[r + 1]))
+            vals += [1.0] * int(model.start[f + 1] - model.start[f]) + [-1.0] * int(model.start[r + 1] - model.start[r])
+            ptr.append(len(cols))
+        k = len(model.prec)
+        h.addRows(k, np.full(k, -inf), np.zeros(k), len(cols), np.array(ptr[:-1], dtype=np.int32),
+                  np.array(cols, dtype=np.int32), np.array(vals))
+    if hint is not None:
+        h.setSolution(_solution(highspy, hint))
+    t0 = time.perf_counter()
+    found: list[float] = []  # times of HiGHS's improving solutions
+    h.cbMipImprovingSolution.subscribe(lambda *_: found.append(time.perf_counter() - t0))
+    if h.run() == highspy.HighsStatus.kError:
+        raise UamoptError("HiGHS stopped with an error", "solver timeindexed", "rerun with output_flag = true to see why")
+    seconds = time.perf_counter() - t0
+    status = h.getModelStatus()
+    info = h.getInfo()
+    sol = h.getSolution()
+    x = np.array(sol.col_value) if sol.value_valid else None
+    if hint is not None and x is not None and abs(float(model.cost @ x) - info.objective_function_value) > 1e-6 * (
+            1.0 + abs(info.objective_function_value)):  # a solution that is not the one reported: trust neither
+        return _highs(model, limit_s, threads, seed, gap, None, presolve)
+    proved = status == highspy.HighsModelStatus.kOptimal
+    bound = float(info.mip_dual_bound) if math.isfinite(info.mip_dual_bound) else None
+    if proved and x is not None:
+        bound = min(bound, float(model.cost @ np.round(x))) if bound is not None else float(model.cost @ np.round(x))
+    return EngineResult(x=x, bound=bound, proved=proved, termination=h.modelStatusToString(status), seconds=seconds,
+                        first_incumbent_s=found[0] if found else None, best_incumbent_s=found[-1] if found else None)
+
+
+def _solution(highspy, x: np.ndarray):
+    sol = highspy.HighsSolution()
+    sol.col_value = list(map(float, x))
+    sol.value_valid = True
+    return sol
+
+
+def _cpsat(model: GridModel, problem: SchedulingProblem, limit_s: float, threads: int, seed: int, gap: float,
+           hint: np.ndarray | None) -> EngineResult:
+    from ortools.sat.python import cp_model
+
+    from uamopt.solvers.cpsat import _bound, _objective
+
+    k_max = np.diff(model.start) - 1
+    per_unit, per_flight, divisor, how = _objective(problem, model.step_s, k_max)
+    m = cp_model.CpModel()
+    x = [m.new_bool_var(f"x{j}") for j in range(model.n_cols)]
+    for r in range(len(model.row_ptr) - 1):
+        m.add_at_most_one([x[j] for j in model.row_col[model.row_ptr[r]:model.row_ptr[r + 1]].tolist()])
+    for f, r in model.prec.tolist():
+        m.add(sum(x[model.start[f]:model.start[f + 1]]) <= sum(x[model.start[r]:model.start[r + 1]]))
+    k_of_col = np.arange(model.n_cols) - np.repeat(model.start[:-1], k_max + 1)
+    coef = (per_unit * k_of_col - per_flight).astype(np.int64).tolist()
+    m.minimize(cp_model.LinearExpr.weighted_sum(x, coef))
+    if hint is not None:
+        for j in range(model.n_cols):
+            m.add_hint(x[j], bool(hint[j] > 0.5))
+    solver = cp_model.CpSolver()
+    solver.parameters.max_time_in_seconds = float(limit_s)
+    solver.parameters.num_workers = int(threads)
+    solver.parameters.random_seed = int(seed)
+    solver.parameters.relative_gap_limit = float(gap)
+    found: list[float] = []
+
+    class _Times(cp_model.CpSolverSolutionCallback):
+        def on_solution_callback(self) -> None:
+            found.append(self.wall_time)
+
+    code = solver.solve(m, _Times())
+    has = code in (cp_model.OPTIMAL, cp_model.FEASIBLE)
+    values = np.array([solver.boolean_value(v) for v in x], dtype=float) if has else None
+    bound = _bound(problem, solver.best_objective_bound, per_flight, divisor, model.step_s, how)
+    return EngineResult(x=values, bound=bound, proved=code == cp_model.OPTIMAL, termination=solver.status_name(code),
+                        seconds=float(solver.wall_time), first_incumbent_s=found[0] if found else None,
+                        best_incumbent_s=found[-1] if found else None)
+
+
+def run_engine(engine: str, model: GridModel, problem: SchedulingProblem, limit_s: float, threads: int, seed: int,
+               gap: float = 0.0, hint: np.ndarray | None = None) -> EngineResult:
+    """Solve a :class:`GridModel` with HiGHS or CP-SAT."""
+    if engine == "highs":
+        return _highs(model, limit_s, threads, seed, gap, hint)
+    if engine == "cpsat":
+        return _cpsat(model, problem, limit_s, threads, seed, gap, hint)
+    if engine == "hybrid":  # HiGHS without presolve for incumbents, then CP-SAT from its best for the bound
+        first = _highs(model, HYBRID_HIGHS_SHARE * limit_s, threads, seed, gap, hint, presolve=False)
+        if first.proved:
+            return first
+        start = first.x if first.x is not None else hint
+        second = _cpsat(model, problem, (1 - HYBRID_HIGHS_SHARE) * limit_s, threads, seed, gap, start)
+        xs = [r.x for r in (first, second) if r.x is not None]
+        x = min(xs, key=lambda v: float(model.cost @ v)) if xs else None
+        bounds = [b for b in (first.bound, second.bound) if b is not None]  # both bound the same model
+        best_t = second.best_incumbent_s if x is second.x and second.best_incumbent_s is not None else first.best_incumbent_s
+        return EngineResult(x=x, bound=max(bounds) if bounds else None, proved=first.proved or second.proved,
+                            termination=f"highs: {first.termination}; cpsat: {second.termination}",
+                            seconds=first.seconds + second.seconds, first_incumbent_s=first.first_incumbent_s,
+                            best_incumbent_s=(best_t + (first.seconds if x is second.x else 0.0)) if best_t is not None else None)
+    raise UamoptError(f"unknown engine '{engine}'", "solver timeindexed", "use engine = \"auto\", \"highs\", \"cpsat\" or \"hybrid\"")
+
+
+# --- the solver ------------------------------------------------------------------------------------
+def solve(problem: SchedulingProblem, profile) -> Schedule:
+    """Build the time-indexed model, warm-start it, solve it; see the module docstring."""
+    check_options(profile.options, KNOWN, "timeindexed")
+    o = profile.options
+    step = float(o.get("step_s", 10.0))
+    kind = str(o.get("model", "grid"))
+    engine = str(o.get("engine", "auto"))
+    gap = float(o.get("mip_rel_gap", 0.0))
+    cont_s = float(o.get("continuous_bound_s", 0.0))
+    t0 = time.perf_counter()
+    start: Start = warm_start(problem, step, soa_s=float(o.get("warm_soa_s", 0.0)), seed=profile.seed, on_grid=True)
+    small = reduced(problem)  # dominance caps: the same optima (warmstart.py)
+    if engine == "auto":  # measured (docs/exact_scheduling.md): HiGHS proves ≤ 600 flights, CP-SAT gets further beyond
+        engine = "highs" if int(np.sum(np.floor(small.delay_upper_s / step) + 1)) <= AUTO_HIGHS_COLUMNS else "hybrid"
+    model = build_grid_model(small, step, kind, both_ways=engine == "cpsat")
+    built = time.perf_counter() - t0
+    hint = model.columns_of(start.operated, start.delay_s) if kind == "grid" else None
+    limit = max(0.1, profile.time_limit_s - built - cont_s)
+    result = run_engine(engine, model, problem, limit, profile.threads, profile.seed, gap, hint)
+    extras = {"model": model_name(kind, step), "engine": engine, "termination": result.termination,
+              "columns": model.n_cols, "rows": model.n_rows, "build_seconds": round(built, 3),
+              "warm_start": f"{start.source} {start.objective:.6f}", "warm_start_s": round(start.seconds, 3),
+              "engine_first_incumbent_s": result.first_incumbent_s, "engine_best_incumbent_s": result.best_incumbent_s,
+              "engine_seconds": round(result.seconds, 3)}
+    n = problem.n_flights
+    if kind == "relaxed":  # a bound only: the incumbent shown is the warm start (feasible, continuous)
+        extras["incumbent"] = f"warm start ({start.source}); the relaxation's points are not schedules"
+        return make_schedule(problem, "timeindexed", "time_limit", start.operated, start.delay_s, bound=result.bound,
+                             solve_seconds=time.perf_counter() - t0, seed=profile.seed, extras=extras)
+    if result.x is None:
+        operated, delay = np.zeros(n, dtype=bool), np.zeros(n)
+    else:
+        operated, delay = model.decode(result.x)
+    status = "optimal" if result.proved else "time_limit"
+    schedule = make_schedule(problem, "timeindexed", status, operated, delay, bound=result.bound,
+                             solve_seconds=time.perf_counter() - t0, seed=profile.seed, extras=extras)
+    schedule = no_worse(problem, schedule, start)
+    if cont_s > 0:
+        c_step = float(o.get("continuous_bound_step_s", step))
+        relaxed = build_grid_model(reduced(problem), c_step, "relaxed")
+        left = max(0.1, profile.time_limit_s - (time.perf_counter() - t0))
+        r = run_engine(engine, relaxed, problem, left, profile.threads, profile.seed, gap, None)
+        schedule.extras.update(continuous_bound=r.bound, continuous_bound_model=model_name("relaxed", c_step),
+                               continuous_bound_termination=r.termination)
+        schedule = make_schedule(problem, "timeindexed", schedule.status, schedule.operated, schedule.delay_s,
+                                 bound=schedule.bound, solve_seconds=time.perf_counter() - t0, seed=profile.seed,
+                                 extras=schedule.extras)
+    return schedule
