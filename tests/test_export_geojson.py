@@ -37,8 +37,6 @@ def test_files_read_back_inside_the_city(exported):
         assert west - tol <= x0 < x1 <= east + tol and south - tol <= y0 < y1 <= north + tol
     tracks = gpd.read_file(exported / "tracks.geojson")
     assert sorted(tracks["id"]) == sorted(f["id"] for f in flights)
-    import csv
-
     with open(exported / "schedule.csv", newline="", encoding="utf-8") as fh:
         operated = {r["flight"]: r["operated"] == "1" for r in csv.DictReader(fh)}
     assert tracks.has_z.all() and dict(zip(tracks["id"], tracks["operated"].astype(bool))) == operated
