@@ -154,3 +154,10 @@ def test_helsinki_reproduce_end_to_end(tmp_path):
         assert json.loads((folder / "summary.json").read_text())["flights"] == 200
     report = (out / "report.md").read_text()
     assert "the paper has no figures for this track" in report and "[196]" not in report and "[109]" not in report
+
+
+def test_explicit_end_points_override_the_route():
+    scenario = load_scenario(PAPER_CASE, ["tracks.origin=[300.0,300.0,150.0]", "tracks.route=['V2','V3']"])
+    origin, destination = default_endpoints(scenario)
+    assert origin.point == (300.0, 300.0, 150.0) and origin.where == "tracks.origin"
+    assert destination.name == "V3" and destination.point == (2220.0, 300.0, 120.0)

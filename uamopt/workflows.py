@@ -8,7 +8,6 @@ command writes. ``figures=False`` skips the PNGs (``--no-figures``).
 from __future__ import annotations
 
 import sys
-import time
 from pathlib import Path
 
 from uamopt.scenario import Scenario
@@ -155,6 +154,3 @@ def schedule_folder(scenario: Scenario, out: str | Path, profile, flights_file=N
     write_schedule(out, problem, schedule, extra=schedule_provenance(scenario, list(overrides or [])))
     return problem, schedule, verify_dir(out)
 
-
-def elapsed_since(started: float) -> float:
-    return time.perf_counter() - started

@@ -30,7 +30,7 @@ def inputs(name: str, cell: float) -> dict:
     import numpy as np
 
     from uamopt.planning import plan_track, planning_model
-    from uamopt.planning.network import network_document, plan_network
+    from uamopt.planning.network import plan_network
     from uamopt.planning.pareto import weight_sweep
     from uamopt.scenario import load_scenario
     from uamopt.stages import compute_risk
@@ -45,7 +45,7 @@ def inputs(name: str, cell: float) -> dict:
     if name == "pareto":
         out["points"] = weight_sweep(model, "V1", "V4", 9)
     if name in ("network", "gantt", "delays"):
-        out["network"] = doc = network_document(model, plan_network(model))
+        out["network"] = doc = plan_network(model).to_document()
     if name in ("gantt", "delays"):
         from uamopt.schedule import build_problem, generate_plan
         from uamopt.solvers import load_profile, solve

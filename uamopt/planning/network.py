@@ -193,11 +193,6 @@ def straight_routes(model: PlanningModel, progress=None) -> RouteNetwork:
                         model.scenario.tracks.layering)
 
 
-def network_document(model: PlanningModel, network: RouteNetwork) -> dict:
-    """The JSON document of ``network.json`` (kept for callers of the first API)."""
-    return network.to_document()
-
-
 def load_network(path: str | Path) -> RouteNetwork:
     """A :class:`RouteNetwork` from ``network.json`` (a file, or the folder holding it)."""
     path = Path(path)
