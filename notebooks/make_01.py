@@ -24,7 +24,7 @@ import pandas as pd
 from scipy.integrate import solve_ivp
 
 import uamopt.plotting as plotting
-from uamopt import build_grid, load_city, load_scenario, risk_field
+from uamopt import scenario_grid, load_city, load_scenario, risk_field
 from uamopt.risk import (crash_area, drag_constant, fall_time, fatality_probability, impact_energy,
                          impact_speed, mean_relative_speed, vehicle_collision_probability)
 
@@ -38,7 +38,7 @@ Cells are 50 × 50 × 30 m (Sec. 6.2) over the seeded synthetic Nanjing-like cit
 Eq. 8, $R = \\omega_1 R^P + \\omega_2 R^V + \\omega_3 R^U$, in every free cell (NaN inside or below
 buildings) and Eq. 9, the binary field: unsafe where $R > R_0$, in obstacles and in no-fly zones."""),
     code("""scenario = load_scenario(scenario_path)
-grid = build_grid(scenario)
+grid = scenario_grid(scenario)
 city = load_city(scenario, grid)
 field = risk_field(scenario, grid, city)
 print(f"grid {grid.shape} cells of {grid.cell} m; city: {city.attribution}")

@@ -20,13 +20,22 @@ def root() -> Path:
     return ROOT
 
 
+def _risk_run(path, overrides=()):
+    """The scenario and its risk field (grid and city within), as ``.scenario``, ``.grid``, ``.field``."""
+    from types import SimpleNamespace
+
+    from uamopt.pipeline import compute_risk
+    from uamopt.scenario import load_scenario
+
+    scenario = load_scenario(path, list(overrides))
+    field = compute_risk(scenario)
+    return SimpleNamespace(scenario=scenario, grid=field.grid, city=field.city, field=field)
+
+
 @pytest.fixture(scope="session")
 def paper_run():
     """The paper case at its default 50 × 50 × 30 m cells."""
-    from uamopt.scenario import load_scenario
-    from uamopt.stages import compute_risk
-
-    return compute_risk(load_scenario(PAPER_CASE))
+    return _risk_run(PAPER_CASE)
 
 
 @pytest.fixture(scope="session")
@@ -40,23 +49,25 @@ def paper_model(paper_run):
 @pytest.fixture(scope="session")
 def coarse_run():
     """The paper case at 100 × 100 × 60 m cells: small enough for graph and figure tests."""
-    from uamopt.scenario import load_scenario
-    from uamopt.stages import compute_risk
-
-    return compute_risk(load_scenario(PAPER_CASE, ["grid.cell=[100,100,60]"]))
+    return _risk_run(PAPER_CASE, ["grid.cell=[100,100,60]"])
 
 
 @pytest.fixture(scope="session")
 def paper_straight_plan():
     """(scenario, grid, straight network, generated plan) of the paper case, seed 0, with Eq. 29
-    taken with equality (max_delay_scale = 1, not the calibrated 0.3)."""
+    taken with equality (max_delay_scale = 1, not the calibrated 0.3).
+
+    The return directions fly one cell layer up (``layer_offset_cells=1``), inside the r = 1
+    conflict zone, not on the r + 1 layer of the planned network: opposite directions then meet
+    head-on, a harder scheduling instance, and the one the regression values of the solver tests
+    were recorded on."""
     from uamopt.grid import AirspaceGrid
     from uamopt.scenario import load_scenario
     from uamopt.schedule import generate_plan, straight_network
 
     scenario = load_scenario(PAPER_CASE)
     grid = AirspaceGrid.from_extent(scenario.grid.cell, scenario.grid.extent)
-    network = straight_network(scenario, grid)
+    network = straight_network(scenario, grid, layer_offset_cells=1)
     return scenario, grid, network, generate_plan(scenario, network, seed=0, max_delay_scale=1.0)
 
 
@@ -139,9 +150,9 @@ def paper_problem(paper_straight_plan):
 
 @pytest.fixture(scope="session")
 def calibrated_problem(paper_straight_plan):
-    """The scheduling model of the calibrated paper-case plan (uamopt/solvers/calibration.py)."""
+    """The scheduling model of the calibrated paper-case plan (uamopt/schedule/calibration.py)."""
     from uamopt.schedule import build_problem
-    from uamopt.solvers.calibration import paper_case_plan
+    from uamopt.schedule.calibration import paper_case_plan
 
     scenario, _, network, _ = paper_straight_plan
     return build_problem(paper_case_plan(scenario, network, seed=0), scenario)

@@ -21,7 +21,8 @@ from affine import Affine
 from uamopt.city import load_city, source_extent
 from uamopt.city.dsm import dsm_extent, load_dsm
 from uamopt.errors import InputFileError, ScenarioError
-from uamopt.grid import AirspaceGrid, build_grid
+from uamopt.grid import AirspaceGrid
+from uamopt.pipeline import scenario_grid
 from uamopt.scenario import load_scenario
 
 LEFT, BOTTOM = 400_000.0, 6_600_000.0  # UTM 33N, metres
@@ -92,14 +93,14 @@ def dsm_city_with_every_layer(directory: Path) -> Path:
 
 def _layers(directory: Path, overrides: list[str] | None = None):
     scenario = load_scenario(directory / "city.toml", overrides)
-    grid = build_grid(scenario)
+    grid = scenario_grid(scenario)
     return grid, load_city(scenario, grid)
 
 
 def test_extent_is_raster_size(dsm_dir):
     scenario = load_scenario(dsm_dir / "city.toml")
     assert dsm_extent(scenario) == source_extent(scenario) == (200.0, 300.0)
-    assert build_grid(scenario).shape == (10, 15, 30)
+    assert scenario_grid(scenario).shape == (10, 15, 30)
 
 
 def test_heights_and_orientation(dsm_dir):
@@ -194,13 +195,13 @@ def test_low_patch_is_an_obstacle_but_not_a_clearance_source(dsm_dir):
     """Eq. 15 measures s_min from building cells: a 6 m patch below building_min_height_m = 8 m is an
     obstacle the track cannot enter, but the cell 10 m above it stays admissible."""
     from uamopt.planning import planning_model
-    from uamopt.stages import compute_risk
+    from uamopt.pipeline import compute_risk
 
     band = ["aircraft.h_min=0.0", "grid.h_min_airspace=0.0", "city.ground_m=4.0"]
 
     def model(min_height: float):
         scenario = load_scenario(dsm_dir / "city.toml", band + [f"city.building_min_height_m={min_height}"])
-        return planning_model(scenario, compute_risk(scenario).field)
+        return planning_model(scenario, compute_risk(scenario))
 
     low = model(8.0)  # the ground between the blocks stands 6 m above the datum: a low patch
     assert low.field.obstacle[4, 7, 0] and low.field.city.building_height[4, 7] == 0.0

@@ -17,7 +17,8 @@ from pyproj import Transformer  # noqa: E402
 from uamopt.city import load_city, source_extent  # noqa: E402
 from uamopt.city.osm import load_osm, parse_height_m, parse_levels  # noqa: E402
 from uamopt.errors import InputFileError, ScenarioError  # noqa: E402
-from uamopt.grid import AirspaceGrid, build_grid  # noqa: E402
+from uamopt.grid import AirspaceGrid  # noqa: E402
+from uamopt.pipeline import scenario_grid
 from uamopt.scenario import Scenario, load_scenario  # noqa: E402
 
 HELSINKI = ["city.source=osm", "city.pbf=helsinki"]
@@ -65,7 +66,7 @@ def test_helsinki_loads(city):
 
 def test_grid_extent_from_data(scenario, city):
     assert source_extent(scenario) == city.extent
-    grid = build_grid(scenario.with_overrides(["grid.cell=[20,20,10]"]))
+    grid = scenario_grid(scenario.with_overrides(["grid.cell=[20,20,10]"]))
     assert grid.shape == (int(city.extent[0] // 20), int(city.extent[1] // 20), 30)
 
 
@@ -158,7 +159,7 @@ def test_helsinki_scenario_validates():
 
     scenario = load_scenario(Path(__file__).parents[1] / "models" / "helsinki.toml")
     assert scenario.name == "helsinki" and scenario.city.source == "osm"
-    grid = build_grid(scenario)
+    grid = scenario_grid(scenario)
     assert grid.cell == (20.0, 20.0, 10.0) and grid.shape[2] == 30
     layers = load_city(scenario, grid)
     for port in scenario.network.vertiports:  # on open ground, inside the extent

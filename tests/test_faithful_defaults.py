@@ -21,13 +21,13 @@ from uamopt.planning import plan_track, planning_model
 from uamopt.planning.endpoints import PAPER_DESTINATION, PAPER_ORIGIN, default_endpoints
 from uamopt.planning.pareto import weight_sweep
 from uamopt.scenario import load_scenario
-from uamopt.stages import compute_risk
+from uamopt.pipeline import compute_risk
 
 
 def _model(side: float, extra: list[str] | None = None):
     scenario = load_scenario(PAPER_CASE, [f"grid.cell=[{side},{side},{side}]", "grid.extent=[2500.0,4500.0,360.0]"]
                              + list(extra or []))
-    return planning_model(scenario, compute_risk(scenario).field)
+    return planning_model(scenario, compute_risk(scenario))
 
 
 def transport_cost(scenario, waypoints) -> float:

@@ -9,7 +9,7 @@ import networkx as nx
 import numpy as np
 import pytest
 
-from uamopt.graph import neighbour_moves, to_networkx
+from uamopt.planning.graph import neighbour_moves, to_networkx
 
 
 @pytest.fixture(scope="module")

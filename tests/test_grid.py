@@ -8,6 +8,7 @@ from hypothesis import given, strategies as st
 
 from uamopt.errors import GridError
 from uamopt.grid import AirspaceGrid, altitude_band, build_grid
+from uamopt.pipeline import scenario_grid
 from uamopt.scenario import Scenario
 
 
@@ -63,5 +64,5 @@ def test_altitude_band_eq14():
 
 def test_build_grid_uses_extent_or_city(root):
     s = Scenario()
-    g = build_grid(s)  # synthetic city extent, z up to h'_max
+    g = scenario_grid(s)  # synthetic city extent, z up to h'_max
     assert g.extent == (2500.0, 4500.0, 300.0)

@@ -13,7 +13,7 @@ from oracles import objective
 from uamopt.errors import UamoptError
 from uamopt.schedule import Flight, FlightSet, build_problem, violations
 from uamopt.solvers import SolverProfile, bruteforce, solve
-from uamopt.solvers.calibration import paper_case_plan
+from uamopt.schedule.calibration import paper_case_plan
 from uamopt.solvers.genetic import fitness, objective_values
 from uamopt.solvers.greedy import CANCEL, decoder_for, greedy_decisions
 from uamopt.solvers.rolling import pair_matching_bound
@@ -113,7 +113,7 @@ def paper_results(calibrated_problem):
 
 # Regression values, not the paper's (Table 3 has 109 / 11 / 2401 s on its own, unpublished plan):
 # what this code's preliminary strategy gave on the calibrated plan, seed 0, when the calibration
-# was chosen (uamopt/solvers/calibration.py). A change here means the plan or greedy changed.
+# was chosen (uamopt/schedule/calibration.py). A change here means the plan or greedy changed.
 REGRESSION_GREEDY_SEED0 = (104, 16, 2260.0)  # operated, cancelled, total delay (s)
 
 

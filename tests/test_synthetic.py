@@ -12,7 +12,8 @@ from shapely.geometry import LineString, box
 from uamopt.city import load_city
 from uamopt.city.layers import VectorCity, burn_max, rasterize_city, segment_length_per_cell
 from uamopt.city.synthetic import synthetic_city
-from uamopt.grid import AirspaceGrid, build_grid
+from uamopt.grid import AirspaceGrid
+from uamopt.pipeline import scenario_grid
 from uamopt.scenario import CityConfig, load_scenario
 
 
@@ -60,7 +61,7 @@ def test_towers_stand_near_the_long_diagonals(paper):
 
 
 def test_layers_on_the_paper_grid(paper):
-    grid = build_grid(paper)
+    grid = scenario_grid(paper)
     layers = load_city(paper, grid)
     assert layers.surface_height.shape == (50, 90)
     assert layers.building.mean() > 0.2

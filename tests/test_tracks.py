@@ -10,13 +10,13 @@ from hypothesis import given, settings, strategies as st
 from scipy.spatial import cKDTree
 
 from uamopt.errors import UamoptError
-from uamopt.geometry import polyline_pieces
+from uamopt.grid.geometry import polyline_pieces
 from uamopt.planning import plan_track, planning_model
 from uamopt.planning.network import load_network, plan_network
 from uamopt.planning.problem import SHORTEST_TIE_BREAK, buffer_cells, buffer_shell_count, box_counts, load_factor, transport_rates
 from uamopt.planning.tracks import corner_fillets, exact_equivalent_track, midpoint_track
 from uamopt.scenario import Scenario, load_scenario
-from uamopt.stages import compute_risk
+from uamopt.pipeline import compute_risk
 
 P_O, P_D = (300.0, 300.0, 120.0), (2220.0, 4220.0, 120.0)
 
@@ -150,7 +150,7 @@ def test_origin_inside_a_building(model):
 
 def test_range_limit(root):
     s = load_scenario(root / "models" / "paper_case.toml", ["aircraft.range_m=3000"])
-    m = planning_model(s, compute_risk(s).field)
+    m = planning_model(s, compute_risk(s))
     with pytest.raises(UamoptError, match="range"):
         plan_track(m, P_O, P_D)
 
@@ -158,10 +158,10 @@ def test_range_limit(root):
 def test_aircraft_limits(root):
     s = load_scenario(root / "models" / "paper_case.toml", ["tracks.wind_speed_mps=30"])
     with pytest.raises(UamoptError, match="wind"):
-        planning_model(s, compute_risk(s).field)
+        planning_model(s, compute_risk(s))
     s = load_scenario(root / "models" / "paper_case.toml", ["aircraft.mass_max_kg=600"])
     with pytest.raises(UamoptError, match="take-off mass"):
-        planning_model(s, compute_risk(s).field)
+        planning_model(s, compute_risk(s))
 
 
 def test_network_directions_on_separate_layers(model, tmp_path):
@@ -191,7 +191,7 @@ def test_share_variant_gives_table2_shape(root):
     """With R(t) as the unsafe share of the buffer's shell, the initial, equivalent and optimal
     tracks carry less risk than the shortest and cost more (the shape of the paper's Table 2)."""
     s = load_scenario(root / "models" / "paper_case.toml", ["tracks.buffer_measure=share"])
-    m = planning_model(s, compute_risk(s).field)
+    m = planning_model(s, compute_risk(s))
     assert m.shell_count.max() <= 1.0
     st_ = plan_track(m, P_O, P_D).stages
     for name in ("initial", "equivalent", "optimal"):

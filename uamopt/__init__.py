@@ -37,7 +37,7 @@ __version__ = "0.1.0"
 #: public name -> module that defines it (imported on first access, PEP 562)
 _LAZY = {
     "Scenario": "uamopt.scenario", "load_scenario": "uamopt.scenario",
-    "AirspaceGrid": "uamopt.grid", "build_grid": "uamopt.grid",
+    "AirspaceGrid": "uamopt.grid", "build_grid": "uamopt.grid", "scenario_grid": "uamopt.pipeline",
     "CityLayers": "uamopt.city", "load_city": "uamopt.city",
     "RiskField": "uamopt.risk", "risk_field": "uamopt.risk",
     "compute_risk": "uamopt.pipeline", "planning_model": "uamopt.pipeline", "plan_track": "uamopt.pipeline",

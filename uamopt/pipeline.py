@@ -33,10 +33,25 @@ if TYPE_CHECKING:
 
     from uamopt.planning.network import RouteNetwork
     from uamopt.planning.problem import PlanningModel
+    from uamopt.grid import AirspaceGrid
     from uamopt.risk import RiskField
     from uamopt.schedule.flights import FlightSet
     from uamopt.schedule.model import Schedule, SchedulingProblem
     from uamopt.solvers import SolverProfile
+
+
+def scenario_grid(scenario: Scenario) -> AirspaceGrid:
+    """The scenario's grid: ``grid.extent`` (default: the city source's extent up to h'_max) in
+    ``grid.cell`` cells, refused before allocation when larger than ``grid.memory_limit_gb``."""
+    from uamopt.city import source_extent
+    from uamopt.grid import build_grid
+
+    if scenario.grid.extent is not None:
+        extent = scenario.grid.extent
+    else:
+        ex, ey = source_extent(scenario)
+        extent = (ex, ey, scenario.grid.h_max_airspace)
+    return build_grid(extent, scenario.grid.cell, memory_limit_gb=scenario.grid.memory_limit_gb)
 
 
 def compute_risk(scenario: Scenario) -> RiskField:
@@ -46,11 +61,10 @@ def compute_risk(scenario: Scenario) -> RiskField:
     ``summary()`` gives the risk command's ``summary.json``.
     """
     from uamopt.city import load_city
-    from uamopt.grid import build_grid
     from uamopt.risk import risk_field
 
     t0 = time.perf_counter()
-    grid = build_grid(scenario)
+    grid = scenario_grid(scenario)
     city = load_city(scenario, grid)
     t1 = time.perf_counter()
     field = risk_field(scenario, grid, city)

@@ -98,13 +98,13 @@ def network_folder(scenario: Scenario, out: str | Path, figures: bool = True):
 def scenario_flights(scenario: Scenario, flights_file=None, network_file=None, seed: int | None = None):
     """The flights to schedule: ``flights_file`` (self-contained, or on ``network_file``'s routes),
     else the generated plan on ``network_file`` or on the network planned now."""
-    from uamopt.grid import build_grid
+    from uamopt.pipeline import scenario_grid
     from uamopt.io import load_flights, load_network
     from uamopt.pipeline import compute_risk, generate_flights, plan_network, planning_model
 
     network = load_network(network_file) if network_file else None
     if flights_file:
-        return load_flights(flights_file, scenario, build_grid(scenario), network and network.waypoints())
+        return load_flights(flights_file, scenario, scenario_grid(scenario), network and network.waypoints())
     if network is None:
         network = plan_network(planning_model(scenario, compute_risk(scenario)))
     return generate_flights(scenario, network, seed)

@@ -33,10 +33,10 @@ def inputs(name: str, cell: float) -> dict:
     from uamopt.planning.network import plan_network
     from uamopt.planning.pareto import weight_sweep
     from uamopt.scenario import load_scenario
-    from uamopt.stages import compute_risk
+    from uamopt.pipeline import compute_risk
 
     scenario = load_scenario(ROOT / "models" / "paper_case.toml", [f"grid.cell=[{cell},{cell},30.0]"])
-    field = compute_risk(scenario).field
+    field = compute_risk(scenario)
     out = {"scenario": scenario, "field": field}
     if name in ("risk",):
         return out

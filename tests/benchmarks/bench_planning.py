@@ -33,8 +33,8 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
 
-from uamopt import build_grid, load_city, load_scenario, risk_field  # noqa: E402
-from uamopt.graph import grid_graph  # noqa: E402
+from uamopt import scenario_grid, load_city, load_scenario, risk_field  # noqa: E402
+from uamopt.planning.graph import grid_graph  # noqa: E402
 from uamopt.planning import SearchProblem, grid_search, plan_track, planning_model  # noqa: E402
 from uamopt.planning.movingai import movingai_problem, read_map, read_scenarios  # noqa: E402
 from uamopt.planning.tracks import endpoint_cell  # noqa: E402
@@ -61,7 +61,7 @@ def paper_model(cell_m: float):
     """(model, start cell, goal cell, seconds for city + risk field, seconds for planning_model)."""
     scenario = load_scenario(SCENARIO, [f"grid.cell=[{cell_m},{cell_m},{cell_m}]"])
     t0 = time.perf_counter()
-    grid = build_grid(scenario)
+    grid = scenario_grid(scenario)
     field = risk_field(scenario, grid, load_city(scenario, grid))
     t_field = time.perf_counter() - t0
     t0 = time.perf_counter()

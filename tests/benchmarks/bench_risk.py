@@ -26,7 +26,7 @@ ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
 
 from uamopt.city import load_city  # noqa: E402
-from uamopt.grid import build_grid  # noqa: E402
+from uamopt.pipeline import scenario_grid  # noqa: E402
 from uamopt.risk import RiskConstants, risk_field  # noqa: E402
 from uamopt.scenario import load_scenario  # noqa: E402
 
@@ -55,7 +55,7 @@ def main() -> None:
     c = args.cell
     scenario = load_scenario(args.scenario, [f"grid.cell=[{c},{c},{c}]"])
     t0 = time.perf_counter()
-    grid = build_grid(scenario)
+    grid = scenario_grid(scenario)
     city = load_city(scenario, grid)
     t_city = time.perf_counter() - t0
 

@@ -15,7 +15,7 @@ import shapely
 from affine import Affine
 from rasterio import features
 
-from uamopt.geometry import split_segments
+from uamopt.grid.geometry import split_segments
 from uamopt.grid import AirspaceGrid
 from uamopt.scenario import CityConfig
 

@@ -197,7 +197,7 @@ def cmd_bench(args) -> int:
 
 def _cli_problem(scenario, args):
     """--flights (self-contained or on --network routes), else the generated plan (--seed)."""
-    from uamopt.grid import build_grid
+    from uamopt.pipeline import scenario_grid
     from uamopt.planning.network import load_network
     from uamopt.schedule import build_problem, load_flights
 
@@ -207,5 +207,5 @@ def _cli_problem(scenario, args):
             return scheduling_problem(scenario, load_network(args.network), seed)
         return scenario_problem(scenario, seed)
     network = load_network(args.network) if args.network else None
-    flights = load_flights(args.flights, scenario, build_grid(scenario), network)
+    flights = load_flights(args.flights, scenario, scenario_grid(scenario), network)
     return build_problem(flights, scenario, objective=scenario.schedule.objective)

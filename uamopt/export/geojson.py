@@ -124,9 +124,9 @@ def _unsafe_layers(folder: ScheduleFolder, risk: str | Path | None, scenario: st
         except (OSError, KeyError, ValueError) as exc:
             raise InputFileError(f"cannot read {path.name}: {exc}", str(path), "give a risk.npz written by uamopt risk") from None
         return unsafe, obstacle, cell, z, band
-    from uamopt.stages import compute_risk
+    from uamopt.pipeline import compute_risk
 
-    field = compute_risk(recorded_scenario(folder, scenario, overrides)).field
+    field = compute_risk(recorded_scenario(folder, scenario, overrides))
     return field.unsafe, field.obstacle, tuple(field.grid.cell), field.grid.z, tuple(field.band)
 
 

@@ -39,8 +39,7 @@ def direction_layers(model: PlanningModel) -> tuple[int, int]:
     outside its conflict zone (r + 1 layers up, r = ``schedule.conflict_radius``), so opposite
     directions of a route never conflict."""
     grid = model.field.grid
-    k = int(np.floor(model.scenario.network.cruise_altitude_m / grid.cell[2]))
-    up = k + model.scenario.schedule.conflict_radius + 1
+    k, up = grid.direction_layers(model.scenario.network.cruise_altitude_m, model.scenario.schedule.conflict_radius)
     if up >= grid.shape[2] or up not in set(model.field.band_layers().tolist()):
         raise NoTrackError("no cell layer in the altitude band for the return direction",
                            "network.cruise_altitude_m", "lower the cruise altitude or widen the band")

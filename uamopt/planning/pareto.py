@@ -186,9 +186,9 @@ def pareto_front(model: PlanningModel, origin, destination, weights: int | Seque
 
     >>> from uamopt.planning import planning_model
     >>> from uamopt.scenario import Scenario
-    >>> from uamopt.stages import compute_risk
+    >>> from uamopt.pipeline import compute_risk
     >>> scenario = Scenario().with_overrides(["grid.cell=[100,100,60]"])
-    >>> model = planning_model(scenario, compute_risk(scenario).field)
+    >>> model = planning_model(scenario, compute_risk(scenario))
     >>> front = pareto_front(model, (300, 300, 120), (2220, 4220, 120), 5, buffer=False)
     >>> [(round(p.risk_cost), round(p.transport_cost, 2)) for p in front]
     [(3068, 29.15), (2985, 29.52), (2902, 30.25), (2861, 30.61), (2744, 97.11)]

@@ -278,7 +278,7 @@ def _python(problem: SearchProblem, start: int, goal: int, use_heuristic: bool):
 def _networkx(problem: SearchProblem, start: int, goal: int, use_heuristic: bool):
     import networkx as nx
 
-    from uamopt.graph import grid_graph
+    from uamopt.planning.graph import grid_graph
 
     if problem.priority is not None and np.any(problem.priority):
         raise ValueError("the networkx backend has no open-list priority term; use backend 'fast' or 'python'")

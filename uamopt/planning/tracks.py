@@ -27,7 +27,7 @@ import cvxpy as cp
 import numpy as np
 
 from uamopt.errors import GridError, NoTrackError, UamoptError
-from uamopt.geometry import polyline_in_mask, polyline_pieces
+from uamopt.grid.geometry import polyline_in_mask, polyline_pieces
 from uamopt.planning.endpoints import as_endpoint
 from uamopt.planning.problem import PlanningModel
 from uamopt.planning.search import grid_search, warm_up

@@ -10,7 +10,7 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from uamopt.geometry import polyline_pieces
+from uamopt.grid.geometry import polyline_pieces
 from uamopt.plotting.style import layer_of
 
 

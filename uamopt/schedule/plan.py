@@ -38,14 +38,14 @@ def scenario_routes(scenario: Scenario) -> list[tuple[str, str]]:
     return scenario.network.route_list()
 
 
-def straight_network(scenario: Scenario, grid: AirspaceGrid, *, layer_offset_cells: int = 1) -> dict[str, np.ndarray]:
+def straight_network(scenario: Scenario, grid: AirspaceGrid, *, layer_offset_cells: int | None = None
+                     ) -> dict[str, np.ndarray]:
     """Straight tracks for every route of the network, both directions.
 
-    a→b flies at ``network.cruise_altitude_m``; b→a flies ``layer_offset_cells`` cell layers
-    higher (cruise + Δz by default). Each track is ``[origin, destination]`` as (2, 3) points, m.
-
-    Note: with the default 3×3×3 conflict zone (r = 1), one layer apart is still within the zone;
-    ``layer_offset_cells = 2`` separates the two directions completely.
+    a→b flies at ``network.cruise_altitude_m``; b→a flies on the layers of
+    :meth:`AirspaceGrid.direction_layers` (r + 1 cell layers higher, outside the conflict zone: the
+    rule of the planned network, ``network.tracks = "straight"``), or ``layer_offset_cells`` layers
+    higher when given. Each track is ``[origin, destination]`` as (2, 3) points, m.
 
     Examples
     --------
@@ -53,10 +53,13 @@ def straight_network(scenario: Scenario, grid: AirspaceGrid, *, layer_offset_cel
     >>> from uamopt.grid import AirspaceGrid
     >>> net = straight_network(Scenario(), AirspaceGrid((50.0, 50.0, 30.0), (50, 90, 12)))
     >>> len(net), net["V4-V1"][0].tolist()
-    (20, [2220.0, 4220.0, 150.0])
+    (20, [2220.0, 4220.0, 180.0])
     """
     ports = {v.name: v for v in scenario.network.vertiports}
     z_out = scenario.network.cruise_altitude_m
+    if layer_offset_cells is None:
+        k_out, k_back = grid.direction_layers(z_out, scenario.schedule.conflict_radius)
+        layer_offset_cells = k_back - k_out
     z_back = z_out + layer_offset_cells * grid.cell[2]
     network: dict[str, np.ndarray] = {}
     for a, b in scenario_routes(scenario):

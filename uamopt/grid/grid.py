@@ -110,6 +110,17 @@ class AirspaceGrid:
         """Cell index (i, j, k) of one point in metres."""
         return tuple(int(v) for v in self.indices_of(np.asarray(point, dtype=float)))  # type: ignore[return-value]
 
+    def direction_layers(self, cruise_altitude_m: float, conflict_radius: int) -> tuple[int, int]:
+        """Cell layers of a route's two directions (Sec. 4.1.2, docs/readings.md): the layer holding
+        the cruise altitude, and r + 1 layers above it, the first outside its conflict zone
+        (r = ``schedule.conflict_radius``), so opposite directions never conflict.
+
+        >>> AirspaceGrid(cell=(50.0, 50.0, 30.0), shape=(50, 90, 12)).direction_layers(120.0, 1)
+        (4, 6)
+        """
+        k = int(np.floor(cruise_altitude_m / self.cell[2] + 1e-9))
+        return k, k + int(conflict_radius) + 1
+
     def layers_in_band(self, low_m: float, high_m: float) -> np.ndarray:
         """Layer indices k whose centre altitude satisfies low ≤ z_k ≤ high (Eq. 14)."""
         z = self.z
@@ -129,10 +140,10 @@ def altitude_band(scenario: "Scenario") -> tuple[float, float]:
 BYTES_PER_CELL = 160
 
 
-def memory_limit_bytes(scenario: "Scenario") -> int:
-    """``grid.memory_limit_gb``, or 80 % of this machine's physical memory."""
-    if scenario.grid.memory_limit_gb is not None:
-        return int(scenario.grid.memory_limit_gb * 2**30)
+def memory_limit_bytes(limit_gb: float | None = None) -> int:
+    """``limit_gb`` (``grid.memory_limit_gb``) in bytes, or 80 % of this machine's physical memory."""
+    if limit_gb is not None:
+        return int(limit_gb * 2**30)
     try:
         import os
 
@@ -141,32 +152,34 @@ def memory_limit_bytes(scenario: "Scenario") -> int:
         return 8 * 2**30
 
 
-def check_memory(cell, extent, scenario: "Scenario") -> None:
-    """Refuse a grid whose run would need more memory than the limit, before anything is allocated."""
+def check_memory(cell, extent, limit_bytes: int) -> None:
+    """Refuse a grid whose run would need more than ``limit_bytes``, before anything is allocated."""
     cells = 1
     for e, c in zip(extent, cell):
         cells *= max(int(e / c + 1e-9), 0)
-    need, limit = cells * BYTES_PER_CELL, memory_limit_bytes(scenario)
-    if need > limit:
+    need = cells * BYTES_PER_CELL
+    if need > limit_bytes:
         raise GridError(
-            f"a grid of {cells:,} cells needs about {need / 2**30:.1f} GB, more than the limit of {limit / 2**30:.1f} GB",
+            f"a grid of {cells:,} cells needs about {need / 2**30:.1f} GB, more than the limit of {limit_bytes / 2**30:.1f} GB",
             "grid.cell / grid.extent", "use larger cells or a smaller extent, or raise grid.memory_limit_gb")
 
 
-def build_grid(scenario: "Scenario") -> AirspaceGrid:
-    """The scenario's grid; with no ``grid.extent`` the city source's own extent is used.
+def build_grid(extent, cell, *, memory_limit_gb: float | None = None) -> AirspaceGrid:
+    """The grid of whole ``cell``-sized cells inside [0, x_max] × [0, y_max] × [0, z_max] = ``extent``.
+
+    The scenario's grid (its extent defaulting to the city source's) is
+    :func:`uamopt.pipeline.scenario_grid`.
 
     Raises
     ------
     GridError
-        The grid holds no cell, or its run would need more memory than ``grid.memory_limit_gb``.
-    """
-    from uamopt.city import source_extent
+        The grid holds no cell, or its run would need more memory than ``memory_limit_gb``
+        (default: 80 % of this machine's memory).
 
-    if scenario.grid.extent is not None:
-        extent = scenario.grid.extent
-    else:
-        ex, ey = source_extent(scenario)
-        extent = (ex, ey, scenario.grid.h_max_airspace)
-    check_memory(scenario.grid.cell, extent, scenario)
-    return AirspaceGrid.from_extent(scenario.grid.cell, extent)
+    Examples
+    --------
+    >>> build_grid((2500, 4500, 360), (50, 50, 30)).shape
+    (50, 90, 12)
+    """
+    check_memory(cell, extent, memory_limit_bytes(memory_limit_gb))
+    return AirspaceGrid.from_extent(cell, extent)

@@ -82,9 +82,9 @@ def to_networkx(field: RiskField, *, neighbourhood: int = 26) -> nx.Graph:
 
     Examples
     --------
-    >>> from uamopt import load_scenario, build_grid, load_city, risk_field
+    >>> from uamopt import load_scenario, scenario_grid, load_city, risk_field
     >>> s = load_scenario("models/paper_case.toml", ["grid.cell=[250,250,120]"])
-    >>> g = build_grid(s); f = risk_field(s, g, load_city(s, g))
+    >>> g = scenario_grid(s); f = risk_field(s, g, load_city(s, g))
     >>> G = to_networkx(f)
     >>> G.number_of_nodes() == int((~(f.obstacle | f.no_fly)).sum())
     True
