@@ -40,6 +40,7 @@ if TYPE_CHECKING:
 
 DEFAULT_SERVICE_S = 3600.0  # T_f − T_s, s: one hour reproduces F = 6 per aircraft (Eq. 23, Table B.3)
 TIME_TOL_S = 1e-6  # slack for float round-off in time comparisons, s
+MAX_CONFLICT_RADIUS = 10  # r of a flights file: a zone of at most 21³ cells (schedule.conflict_radius's range)
 
 
 def _frozen(array: np.ndarray) -> np.ndarray:
@@ -397,12 +398,14 @@ def load_flights(
         cell_t = ()
     if len(cell_t) != 3 or not all(math.isfinite(c) and c > 0 for c in cell_t):
         raise InputFileError(f"'cell' must be three positive sizes, got {cell!r}", source, "give [dx, dy, dz] in metres")
-    if isinstance(radius, bool) or not isinstance(radius, int) or radius < 0:
-        raise InputFileError(f"'conflict_radius' must be an integer ≥ 0, got {radius!r}", source, "1 = 3×3×3 zone, 0 = same cell")
+    if isinstance(radius, bool) or not isinstance(radius, int) or not 0 <= radius <= MAX_CONFLICT_RADIUS:
+        raise InputFileError(f"'conflict_radius' must be an integer in [0, {MAX_CONFLICT_RADIUS}], got {radius!r}", source,
+                             "1 = 3×3×3 zone, 0 = same cell (schedule.conflict_radius)")
     if grid is not None and cell_t != tuple(grid.cell):
-        from uamopt.grid import AirspaceGrid
+        from uamopt.grid.grid import file_grid
 
-        grid = AirspaceGrid.from_extent(cell_t, grid.extent)  # the file's cell overrides the scenario's
+        # the file's cell overrides the scenario's, within the same memory limit (tiny cells are refused)
+        grid = file_grid(grid.extent, cell_t, scenario.grid.memory_limit_gb if scenario else None, source)
     flights = tuple(flight_from_dict(f, source, network) for f in raw["flights"])
     flightset = _fill_max_delay(FlightSet(cell=cell_t, conflict_radius=radius, flights=flights, **numbers))
     check_flightset(flightset, grid, source)
