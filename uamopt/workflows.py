@@ -154,7 +154,7 @@ def schedule_folder(scenario: Scenario, out: str | Path, profile, flights_file=N
     (problem, schedule, violations found by the independent verifier in the written folder)."""
     from uamopt.export.frame import schedule_provenance
     from uamopt.outputs import check_out_dir
-    from uamopt.pipeline import build_problem, solve
+    from uamopt.pipeline import build_problem, scenario_grid, solve
     from uamopt.schedule import write_schedule
     from uamopt.schedule.verify import verify_dir
     from uamopt.solvers import load_profile
@@ -168,6 +168,7 @@ def schedule_folder(scenario: Scenario, out: str | Path, profile, flights_file=N
         bar.update(1)
         schedule = solve(problem, profile)
         bar.update(1)
-    write_schedule(out, problem, schedule, extra=schedule_provenance(scenario, list(overrides or [])))
+    extent = {"extent_m": list(scenario_grid(scenario).extent)}  # the airspace the verifier holds tracks to
+    write_schedule(out, problem, schedule, extra=schedule_provenance(scenario, list(overrides or [])) | extent)
     return problem, schedule, verify_dir(out)
 
