@@ -117,6 +117,8 @@ def scenario_flights(scenario: Scenario, flights_file=None, network_file=None, s
     from uamopt.pipeline import compute_risk, generate_flights, plan_network, planning_model, scenario_grid
     from uamopt.schedule.airspace import check_tracks
 
+    if not (flights_file or network_file):
+        scenario.network.route_list()  # a network without routes is refused before anything is computed
     network = checked_network(scenario, network_file) if network_file else None
     if flights_file:
         flights = load_flights(flights_file, scenario, scenario_grid(scenario), network and network.waypoints())
