@@ -206,6 +206,7 @@ def write_flights(d: Path) -> None:
     for name, edit in edits.items():
         _json(d / f"flights_{name}.json", _tamper(good, edit))
     (d / "flights_truncated.json").write_text(json.dumps(good)[:100], encoding="utf-8")
+    (d / "flights_deep.json").write_text("[" * 100_000 + "]" * 100_000, encoding="utf-8")
 
 
 def write_folders(d: Path) -> None:

@@ -108,6 +108,9 @@ CASES = [
     ("export-dt-huge", "export bluesky {d}/good --dt 1e9", 2, "--dt"),
     ("export-bank", "export bluesky {d}/good --bank 95", 2, "--bank"),
     ("verify-missing", "verify {d}/nowhere", 2, "not a folder"),
+    ("export-summary-list", "export bluesky {d}/sched_summary_list", 2, "JSON object"),
+    ("export-summary-deep", "export geojson {d}/sched_summary_deep", 2, "malformed JSON"),
+    ("export-no-schedule", "export bluesky {d}/sched_no_schedule", 2, "missing schedule.csv"),
     # --- solver profiles (what passes on main; the lead adds option and seed cases) ------------
     *[(f"profile-{name.replace('_', '-')}", f"{SCHED.replace('greedy', '{d}/profile_' + name + '.toml')} --out {{out}}",
        2, fragment) for name, fragment in (
@@ -134,7 +137,9 @@ CASES = [
         ("tiny_cell", "more than the limit"), ("radius_11", "conflict_radius"), ("radius_true", "conflict_radius"),
         ("duplicate_id", "duplicate flight id"), ("overlap", "overlaps aircraft A"), ("before_start", "before the service"),
         ("after_end", "after the service end"), ("unknown_route", "unknown route"), ("truncated", "malformed JSON"),
-        ("nowhere", "not found"))],
+        ("deep", "nested too deeply"), ("nowhere", "not found"))],
+    ("flights-unreadable", SCHED + " --flights /proc/self/mem --out {out}", 2, "cannot read the flights file"),
+    ("network-unreadable", SCHED + " --network /proc/self/mem --out {out}", 2, "cannot read the network file"),
     ("flights-with-bad-network", SCHED + " --flights {d}/flights.json --network {d}/net_tower.json --out {out}", 2,
      "passes through a building"),
     # --- schedule folders (verify) --------------------------------------------------------------

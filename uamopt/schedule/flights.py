@@ -374,6 +374,12 @@ def load_flights(
         raise InputFileError(f"malformed JSON: {exc.msg} at line {exc.lineno} column {exc.colno}", source, "fix the syntax") from None
     except UnicodeDecodeError:
         raise InputFileError("flights file is not UTF-8 text", source, "save it as UTF-8 JSON") from None
+    except RecursionError:
+        raise InputFileError("the flights file is nested too deeply to read", source, "give a flights.json as "
+                             "docs/interfaces.md describes") from None
+    except OSError as exc:
+        raise InputFileError(f"cannot read the flights file: {exc.strerror or exc}", source,
+                             "check that the file is readable") from None
     if not isinstance(raw, dict) or not isinstance(raw.get("flights"), list):
         raise InputFileError("missing key 'flights' (a list)", source, 'write {"cell": [...], "conflict_radius": r, "flights": [...]}')
     if not raw["flights"]:

@@ -126,7 +126,7 @@ def _read_flights(path: Path) -> dict:
         raw = json.loads(path.read_text(encoding="utf-8-sig"))
         flights = raw["flights"]
         cell = [_number(c, "cell", str(path)) for c in raw["cell"]]
-    except (json.JSONDecodeError, UnicodeDecodeError, RecursionError) as exc:
+    except (json.JSONDecodeError, UnicodeDecodeError, RecursionError, OSError) as exc:
         raise InputFileError(f"malformed JSON: {exc}", str(path), "rewrite the file with uamopt schedule") from None
     except (KeyError, TypeError, ValueError):
         raise InputFileError("missing or malformed 'flights' or 'cell'", str(path), "rewrite the file with uamopt schedule") from None
@@ -202,7 +202,7 @@ def _read_schedule(path: Path) -> dict[str, dict]:
         return _parse_schedule(path, rows)
     except UnicodeDecodeError:
         raise InputFileError("schedule.csv is not UTF-8 text", str(path), "save it as UTF-8 CSV") from None
-    except csv.Error as exc:
+    except (csv.Error, OSError) as exc:
         raise InputFileError(f"malformed CSV: {exc}", str(path), "rewrite it with uamopt schedule") from None
 
 

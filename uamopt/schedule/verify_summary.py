@@ -23,7 +23,7 @@ def check_summary(path: Path, spec: dict, flown: list[dict], n_aircraft: int) ->
     flights.json, ``flown`` its operated flights, ``n_aircraft`` G (Eq. 21)."""
     try:
         summary = json.loads(path.read_text(encoding="utf-8-sig"))
-    except (json.JSONDecodeError, UnicodeDecodeError, RecursionError) as exc:
+    except (json.JSONDecodeError, UnicodeDecodeError, RecursionError, OSError) as exc:
         raise InputFileError(f"malformed JSON: {exc}", str(path), "rewrite it with uamopt schedule") from None
     if not isinstance(summary, dict):
         raise InputFileError("summary.json does not hold a JSON object", str(path), "rewrite it with uamopt schedule")
