@@ -80,6 +80,8 @@ CASES = [
     ("set-weights-negative", "risk {paper} --set tracks.weights=[-1,0] --out {out}", 2, "tracks.weights"),
     ("set-speed-max-below-min", "risk {paper} --set aircraft.speed_max_mps=5 --out {out}", 2, "speed_min_mps"),
     ("set-climb-angle", "risk {paper} --set aircraft.climb_angle_rad=2 --out {out}", 2, "climb_angle_rad"),
+    ("set-cruise-speed", SCHED + " --set aircraft.cruise_speed_mps=1000 --out {out}", 2, "cruise_speed_mps"),
+    ("set-service-long", SCHED + " --set schedule.service_s=1e9 --out {out}", 2, "schedule.service_s"),
     ("set-quadrature-bool", "risk {paper} --set risk.quadrature_points=true --out {out}", 2, "quadrature_points"),
     ("set-delay-scale-bool", "flights {P} --set schedule.max_delay_scale=true --out {out}", 2, "must be a number"),
     ("set-delay-scale-two", "flights {P} --set schedule.max_delay_scale=2 --out {out}", 2, "max_delay_scale"),
@@ -132,6 +134,7 @@ CASES = [
       for name, fragment in (
         ("no_list", "missing key 'flights'"), ("empty", "no flights"), ("not_object", "not a JSON object"),
         ("no_speed", "missing key 'speed_mps'"), ("speed_zero", "non-positive speed"), ("speed_word", "not a finite"),
+        ("speed_fast", "outside 0.1-200 m/s"), ("departure_late", "beyond"), ("service_long", "service_end_s"),
         ("departure_nan", "not a finite"), ("negative_delay", "negative max_delay_s"), ("one_point", "at least two"),
         ("tower", "passes through a building"), ("ground", "on or below the ground"), ("off_grid", "outside the grid"),
         ("tiny_cell", "more than the limit"), ("radius_11", "conflict_radius"), ("radius_true", "conflict_radius"),

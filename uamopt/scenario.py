@@ -99,7 +99,8 @@ class AircraftConfig(_Section):
     climb_angle_rad: Real = Field(
         math.pi / 6, gt=-math.pi / 2, lt=math.pi / 2, description="θ, angle of v_e to the xy plane, rad (A.7-A.9)"
     )
-    cruise_speed_mps: PositiveFloat = Field(25.0, description="v_g, m/s (Eq. 23)")
+    cruise_speed_mps: Annotated[float, BeforeValidator(_number), Field(ge=0.1, le=200.0, allow_inf_nan=False)] = Field(
+        25.0, description="v_g, m/s (Eq. 23); 0.1-200 m/s, the ground speeds `uamopt verify` accepts")
     h_min: NonNegFloat = Field(90.0, description="h_min, aircraft minimum altitude, m (Eq. 14)")
     h_max: PositiveFloat = Field(3000.0, description="h_max, aircraft maximum altitude, m (Eq. 14)")
     range_m: PositiveFloat = Field(30000.0, description="L_e, m (Eq. 17)")
@@ -195,7 +196,8 @@ class NetworkConfig(_Section):
     )
     tracks: Literal["planned", "straight"] = Field(
         "planned", description="the tracks flights fly: planned by A* through the city (Sec. 4.2), or straight "
-        "lines between vertiports, a->b at the cruise altitude and b->a r + 1 layers up (scheduler benchmarks)"
+        "lines between vertiports, a->b at the cruise altitude and b->a r + 1 layers up (scheduler benchmarks); "
+        "'straight' also accepts --network / --flights tracks through buildings (uamopt/schedule/airspace.py)"
     )
 
     def route_list(self) -> list[tuple[str, str]]:
@@ -302,7 +304,9 @@ class ScheduleConfig(_Section):
         10.0, description="ΔT_a, s (Table B.3): the heuristics' delay grid and the grid of generated first departures"
     )
     conflict_radius: Annotated[int, Field(ge=0, le=10, strict=True)] = Field(1, description="r: conflict zone of (2r+1)³ cells")
-    service_s: PositiveFloat = Field(3600.0, description="T_f − T_s, the service window, s (Eq. 23: gives F = 6)")
+    service_s: Annotated[float, BeforeValidator(_number), Field(gt=0, le=1e7, allow_inf_nan=False)] = Field(
+        3600.0, description="T_f − T_s, the service window, s (Eq. 23: gives F = 6); at most 10⁷ s, the times "
+        "`uamopt verify` accepts")
     first_departure_window_s: NonNegFloat = Field(
         600.0, description="first planned departures of the aircraft are drawn in [T_s, T_s + window], s; an "
         "aircraft whose flights leave less slack before T_f draws from that slack (noted in summary.json)"

@@ -33,6 +33,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from uamopt.errors import InputFileError
+from uamopt.schedule.verify import MAX_TIME_S, SPEED_RANGE_MPS  # a file the verifier would refuse is refused first
 
 if TYPE_CHECKING:
     from uamopt.grid import AirspaceGrid
@@ -254,8 +255,15 @@ def flight_from_dict(raw: Any, where: str, network: Mapping[str, np.ndarray] | N
             raise InputFileError(f"'{key}' is not a finite number: {raw[key]!r}", where, f"give '{key}' in seconds or m/s")
     if raw["speed_mps"] <= 0:
         raise InputFileError(f"non-positive speed {raw['speed_mps']!r}", where, "give 'speed_mps' > 0 (v_g, m/s)")
+    if not SPEED_RANGE_MPS[0] <= raw["speed_mps"] <= SPEED_RANGE_MPS[1]:  # what the verifier accepts, checked
+        raise InputFileError(f"speed_mps {raw['speed_mps']:g} is outside {SPEED_RANGE_MPS[0]:g}-{SPEED_RANGE_MPS[1]:g} m/s",
+                             where, "give v_g in m/s (the paper's eVTOL cruises at 25 m/s)")  # before, not after, writing
     if "max_delay_s" in raw and raw["max_delay_s"] < 0:
         raise InputFileError(f"negative max_delay_s {raw['max_delay_s']!r}", where, "give 'max_delay_s' ≥ 0 (Δd, Eq. 29)")
+    for key in ("planned_departure_s", "max_delay_s"):
+        if abs(raw.get(key, 0.0)) > MAX_TIME_S:
+            raise InputFileError(f"'{key}' {raw[key]:g} s is beyond ±{MAX_TIME_S:g} s", where,
+                                 "give times in seconds from the start of service")
     if "waypoints" in raw:
         try:
             wp = np.array(raw["waypoints"], dtype=float)
@@ -395,8 +403,9 @@ def load_flights(
         ("outbound_gap_s", sched.outbound_gap_s if sched else 240.0), ("return_gap_s", sched.return_gap_s if sched else 360.0),
     ):
         value = raw.get(key, default)
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value < 0:
-            raise InputFileError(f"'{key}' must be a number ≥ 0, got {value!r}", source, "give it in seconds")
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0 <= value <= MAX_TIME_S:
+            raise InputFileError(f"'{key}' must be a number in [0, {MAX_TIME_S:g}] s, got {value!r}", source,
+                                 "give it in seconds")
         numbers[key] = float(value)
     try:
         cell_t = tuple(float(c) for c in cell)
