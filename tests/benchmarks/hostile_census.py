@@ -1,7 +1,7 @@
 """Count the outcomes of tests/test_hostile.py's table: cases tried, tracebacks, wrong exit codes,
 malformed error lines and torn outputs (``--out`` or an input changed).
 
-    .venv/bin/python tests/benchmarks/hostile_census.py [--list]
+    .venv/bin/python tests/benchmarks/hostile_census.py [--list] [--timeout SECONDS]
 
 The test asserts each case; this script runs the same table in one process without stopping, so
 the counts can be quoted (and compared with an older checkout of uamopt on ``PYTHONPATH``).
@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import contextlib
 import io
+import signal
 import sys
 import tempfile
 import traceback
@@ -25,22 +26,36 @@ from test_hostile import CASES, _argv, _out, _snapshot  # noqa: E402
 from uamopt.cli import main  # noqa: E402
 
 
-def run_case(case, files: Path, tmp: Path) -> list[str]:
-    """The faults of one case: 'traceback', 'exit code', 'error line', 'torn output'."""
+class Hang(Exception):
+    """A case still running after --timeout seconds."""
+
+
+def _alarm(signum, frame):
+    raise Hang
+
+
+def run_case(case, files: Path, tmp: Path, timeout_s: int = 0) -> list[str]:
+    """The faults of one case: 'hang', 'traceback', 'exit code', 'error line', 'torn output'."""
     name, line, expected, fragment = case
     out = _out(tmp)
     before = _snapshot(files)
     stdout, stderr = io.StringIO(), io.StringIO()
+    faults = []
+    signal.signal(signal.SIGALRM, _alarm)
+    signal.alarm(timeout_s)
     with contextlib.redirect_stdout(stdout), contextlib.redirect_stderr(stderr):
         try:
             code = main(_argv(line, files, out))
         except SystemExit as exc:
             code = exc.code
+        except Hang:
+            faults, code = ["hang"], None
         except BaseException:  # noqa: BLE001 - a traceback the user would see
             traceback.print_exc()
             code = None
-    faults = []
-    if code is None or "Traceback" in stderr.getvalue():
+        finally:
+            signal.alarm(0)
+    if (code is None and not faults) or "Traceback" in stderr.getvalue():
         faults.append("traceback")
     if code != expected:
         faults.append("exit code")
@@ -52,19 +67,22 @@ def run_case(case, files: Path, tmp: Path) -> list[str]:
     return faults
 
 
-def main_census(show: bool) -> Counter:
+def main_census(show: bool, timeout_s: int = 0) -> Counter:
     with tempfile.TemporaryDirectory(prefix="hostile-") as tmp:
         files = write_all(Path(tmp) / "files")
         counts: Counter = Counter()
         for n, case in enumerate(CASES):
-            faults = run_case(case, files, Path(tmp) / f"case{n}")
+            (Path(tmp) / f"case{n}").mkdir()
+            faults = run_case(case, files, Path(tmp) / f"case{n}", timeout_s)
             counts.update(faults)
             if show and faults:
                 print(f"{case[0]}: {', '.join(faults)}")
-    print(f"cases tried: {len(CASES)}; tracebacks: {counts['traceback']}; wrong exit codes: {counts['exit code']}; "
+    print(f"cases tried: {len(CASES)}; hangs: {counts['hang']}; tracebacks: {counts['traceback']}; "
+          f"wrong exit codes: {counts['exit code']}; "
           f"malformed error lines: {counts['error line']}; torn outputs: {counts['torn output']}")
     return counts
 
 
 if __name__ == "__main__":
-    main_census("--list" in sys.argv)
+    args = sys.argv[1:]
+    main_census("--list" in args, int(args[args.index("--timeout") + 1]) if "--timeout" in args else 0)
