@@ -54,3 +54,16 @@ def test_a_stage_imports_only_earlier_stages(path):
 def test_the_grid_knows_nothing_of_cities():
     for path in (ROOT / "uamopt" / "grid").glob("*.py"):
         assert not [n for n, _ in imports(path) if n.startswith(("uamopt.city", "uamopt.risk"))], path.name
+
+
+def test_the_command_line_parser_loads_no_heavy_library():
+    """``uamopt --help`` and argument errors stay instant: building the parser imports no numerical
+    or plotting library (they load when a command runs)."""
+    import subprocess
+    import sys
+
+    code = ("import sys; from uamopt import cli; cli.build_parser(); "
+            "print(sorted(m for m in ('numpy', 'pandas', 'matplotlib', 'scipy', 'dask', 'pyomo', 'ortools', 'cvxpy')"
+            " if m in sys.modules))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, cwd=ROOT)
+    assert out.stdout.strip() == "[]"
