@@ -20,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+from distributed import LocalCluster
 from matplotlib.figure import Figure
 from scipy.integrate import solve_ivp
 
@@ -231,7 +232,11 @@ fig"""),
     code("""sweep_file = root / "models" / "variants" / "altitude.toml"
 spec = ua.load_sweep(sweep_file, small=SMALL)  # the cases, validated, before anything runs
 print(f"{len(spec.cases)} cases:", [case.overrides for case in spec.cases])
-study = ua.sweep(sweep_file, small=SMALL, workers=1 if SMALL else None)
+if SMALL:  # one worker thread of this kernel: nothing to start, the libraries already loaded
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=False, dashboard_address=":0") as cluster:
+        study = ua.sweep(sweep_file, small=True, scheduler=cluster.scheduler_address)
+else:  # ua.sweep's own local cluster, one worker process per CPU
+    study = ua.sweep(sweep_file)
 assert (study["status"] == "ok").all(), study["error"].dropna().tolist()
 ua.plot_sweep(study, "altitude")"""),
     md("""The cruise layer's unsafe share is recomputed below from the city layers alone (free where

@@ -51,7 +51,7 @@ passenger mass of docs/readings.md ($m_p$ = 145.6 kg) that is the paper's shorte
 ¥27.1527. The grid stages (shortest, initial) run between the *centres* of P_O's and P_D's cells,
 so each track is held to the straight line between its own end points. A 26-neighbour path of
 cells moves at most one cell per axis and step, so it visits at least (the largest index difference
-\+ 1) cells and is at least as long as the 26-neighbour distance: straight, face-diagonal and
+\\+ 1) cells and is at least as long as the 26-neighbour distance: straight, face-diagonal and
 space-diagonal moves in the numbers the index differences dictate. The code below computes these
 from Table B.3 and the geometry alone."""),
     code("""a = scenario.aircraft
@@ -157,7 +157,7 @@ counts something else. Computing times are not comparable: the paper's A* (heuri
 68.7 s; ours is compiled and uses an admissible transport-cost heuristic with the same optimal cost
 (docs/readings.md, *Heuristic*). The paper's midpoint rule (the row below the four stages) starts
 and ends at P_O and P_D at 120 m, while the cell centres of the grid path lie half a cell higher or
-lower: those vertical metres cost $c_v \approx 90\,c_h$ each, hence its higher $C_T$; the exact
+lower: those vertical metres cost $c_v \\approx 90\\,c_h$ each, hence its higher $C_T$; the exact
 equivalent track may fly anywhere in the corridor and stays level."""),
     md("## Fig. 18: the tracks"),
     code("""ua.plotting.tracks(plan, model, title=f"P_O -> P_D at {TABLE2_CELL_M:g} m cells")"""),
