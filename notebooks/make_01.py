@@ -124,15 +124,27 @@ table"""),
 $P^V = S_v\\rho_V/w_r$ = 0.1936 (Eq. 5), $R^V = \\lambda\\rho_V l_r P^V$ = 4.092704 × 10⁻⁵ for
 $l_r$ = 50 m (Eq. 4), $v_r'$ ≈ 23.664 m/s (A.6). The fall time is also checked against a numerical
 solution of $\\dot z = v,\\ \\dot v = g - k v^2$ with $k = R_I\\rho_a S_e/(2(m_e+m_p))$ (A.2) computed
-here from Table B.3, and the binary field against two facts of Table B.3: a cell above open
-ground is safe even at terminal speed ($\\omega_1 R^P + \\omega_3 R^U$ stays below $R_0$), a 50 m
-road makes its cell unsafe."""),
+here from Table B.3, and the binary field against two facts of Table B.3: a cell 148.2 m above
+open ground is safe ($\\omega_1 R^P + \\omega_3 R^U$ stays below $R_0$, and docs/readings.md shows it
+does even at terminal speed), a 50 m road makes its cell unsafe."""),
     code("""r, a = scenario.risk, scenario.aircraft
 light = fields[0.0]
 assert math.isclose(light.constants.crash_area_m2 * scenario.city.population_density, 7.068583e-03, rel_tol=1e-6)
 assert math.isclose(light.constants.vehicle_collision_probability, 0.1936, rel_tol=1e-12)
 assert math.isclose(light.risk_V[2, 0, 1], 4.092704e-05, rel_tol=1e-6)
 assert abs(light.constants.mean_relative_speed_mps - 23.664) <= 5e-4
+
+
+def fall_time_ode(k: float) -> float:
+    \"\"\"Time to fall `height` from rest under dv/dt = g - k v² (A.2), by numerical integration.\"\"\"
+    def landed(t, y):
+        return y[0] - height
+    landed.terminal = True
+    sol = solve_ivp(lambda t, y: [y[1], r.gravity_mps2 - k * y[1] ** 2], (0.0, 60.0), [0.0, 0.0], events=landed,
+                    rtol=1e-11, atol=1e-11)
+    return float(sol.t_events[0][0])
+
+
 for payload, f in fields.items():
     w1, w2, w3 = r.weights
     combined = w1 * f.risk_P + w2 * f.risk_V + w3 * f.risk_U  # Eq. 8
@@ -141,14 +153,11 @@ for payload, f in fields.items():
     # the ODE of A.2 from rest, with k from Table B.3 (not from the code)
     mass = a.empty_mass_kg + payload
     k = r.drag_coefficient * r.air_density * (math.pi * a.length_m ** 2 / 4) / (2 * mass)
-    landed = lambda t, y: y[0] - height  # noqa: E731
-    landed.terminal = True
-    sol = solve_ivp(lambda t, y: [y[1], r.gravity_mps2 - k * y[1] ** 2], (0.0, 60.0), [0.0, 0.0], events=landed,
-                    rtol=1e-11, atol=1e-11)
+    t_ode = fall_time_ode(k)
     swept = f.risk_U[0, 0, 1] / (r.failure_rate_per_h * r.uav_density_per_m3 * a.wingspan_m * a.height_m)
     t_field = (swept - a.fuselage_length_m) / f.constants.mean_relative_speed_mps
-    assert math.isclose(sol.t_events[0][0], t_field, rel_tol=1e-8)
-    print(f"m_p = {payload:g} kg: fall time from the field {t_field:.8f} s, ODE {sol.t_events[0][0]:.8f} s; "
+    assert math.isclose(t_ode, t_field, rel_tol=1e-8)
+    print(f"m_p = {payload:g} kg: fall time from the field {t_field:.8f} s, ODE {t_ode:.8f} s; "
           f"open ground R = {f.risk[0, 0, 1]:.3e} < R_0, 50 m road R = {f.risk[2, 0, 1]:.3e}")"""),
     md("""## 3 · Fig. 17: the urban low-altitude airspace after risk assessment
 
@@ -201,17 +210,25 @@ layers = pd.DataFrame({
     "R > R_0 among free cells": over_threshold.sum(axis=(0, 1)) / free.sum(axis=(0, 1)),
 }).rename_axis("layer k")
 layers.style.format(precision=3)"""),
-    md("""**Roads dominate.** With Table B.3 values a road inside a column already gives
-$\\omega_2 R^V > R_0$, while without a road $\\omega_1 R^P + \\omega_3 R^U$ stays below $R_0$ at any
-altitude (docs/readings.md, *What the model gives*). So above the buildings the binary field is
-the road map, the same at every altitude. The checks below assert it for this city: every free
-cell above a road is unsafe, none above open ground is, and the continuous risk of a column never
-falls with altitude ($R^P$ grows with the impact speed, $R^U$ with the fall time, $R^V$ is
+    md("""**Roads dominate.** With Table B.3 values a road of only
+$l_r > R_0 / (\\omega_2 \\lambda \\rho_V P^V)$ = 0.407 m inside a column already gives
+$\\omega_2 R^V > R_0$ on its own, while without a road $\\omega_1 R^P + \\omega_3 R^U$ stays below
+$R_0$ at any altitude (docs/readings.md, *What the model gives*). So above the buildings the
+binary field is the road map, the same at every altitude; only a sliver of road (0 < $l_r$ ≤ 0.407
+m, where $R^P$ must make up the rest) could depend on altitude, and this city has none. The checks
+below assert it (the 0.407 m computed here from Table B.3), and that the continuous risk of a column
+never falls with altitude ($R^P$ grows with the impact speed, $R^U$ with the fall time, $R^V$ is
 constant)."""),
-    code("""road = (city.road_length > 0)[:, :, None]
+    code("""w2 = r.weights[1]
+road_min_m = r.threshold / (w2 * r.failure_rate_per_h * r.traffic_density_per_m
+                            * r.vehicle_area_m2 * r.traffic_density_per_m / r.road_width_m)  # Eqs. 4-5, 8-9
+assert abs(road_min_m - 0.407) < 5e-4
+road = (city.road_length > road_min_m)[:, :, None]
+no_road = (city.road_length == 0)[:, :, None]
 in_air = free & ~field.no_fly
 assert np.all(field.unsafe[in_air & road]), "a free cell above a road is below R_0"
-assert not np.any(field.unsafe[in_air & ~road]), "a cell above open ground exceeds R_0"
+assert not np.any(field.unsafe[in_air & no_road]), "a cell above open ground exceeds R_0"
+assert not np.any((city.road_length > 0) & (city.road_length <= road_min_m))  # no slivers in this city
 both_free = free[:, :, 1:] & free[:, :, :-1]
 assert np.all(field.risk[:, :, 1:][both_free] >= field.risk[:, :, :-1][both_free] * (1 - 1e-12))
 print(f"columns with a road: {(city.road_length > 0).mean():.1%}; unsafe in the band: {field.unsafe[:, :, band].mean():.1%}")"""),

@@ -189,10 +189,11 @@ table4 = pd.DataFrame({
     **{f"uamopt {side:g} m": formatted(values) for side, values in mine.items()},
     "uamopt change": [f"{f / c - 1:+.2%}" for c, f in zip(*mine.values())],
 }, index=pd.Index(QUANTITIES, name="optimal track"))
-for side, p in plans.items():
+for p in plans.values():
     stage = p.stages["optimal"]
     assert bounds_hold(stage) and abs(transport_cost(stage.waypoints) - stage.transport_cost) < 1e-9 * 30
-assert fine.risk_cost < coarse.risk_cost  # the paper's direction: finer cells, less risk
+assert fine.risk_cost < coarse.risk_cost  # the paper's direction: finer cells, less risk (-16.67 %)
+assert fine.n_waypoints > coarse.n_waypoints  # and more waypoints (+64.89 %)
 assert PAPER_TABLE4["5 m"][1] < straight_yuan  # the paper's 5 m cost is below the straight line (see below)
 table4"""),
     md("""**Where ours differ, and why.** Risk falls with finer cells as in the paper, and for the reason

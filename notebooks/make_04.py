@@ -41,12 +41,20 @@ print("buildings:", summary["city"])"""),
 Building heights come from the `height` tag, else `building:levels` × 3 m, else 12 m (the counts
 above: most buildings of the extract carry neither tag, so their 12 m is a default, not data).
 Roads are the driving network. The fact docs/readings.md reports for Table B.3 (*What the model
-gives*) holds in a real city too: above the roofs, every cell over a road exceeds $R_0$ and no cell
-over open ground does — checked here on this city's own layers."""),
+gives*) holds in a real city too: above the roofs, every cell over more than 0.407 m of road
+exceeds $R_0$ (ω2·R^V alone does, Eqs. 4–5) and no cell over open ground does — checked here on
+this city's own layers. Cells over a mere sliver of road (a street corner clipping the column) may
+go either way, by altitude."""),
     code("""city, grid = field.city, field.grid
+r = scenario.risk
+road_min_m = r.threshold / (r.weights[1] * r.failure_rate_per_h * r.traffic_density_per_m
+                            * r.vehicle_area_m2 * r.traffic_density_per_m / r.road_width_m)  # Eqs. 4-5, 8-9
 free = ~field.obstacle & ~field.no_fly
-road = (city.road_length > 0)[:, :, None]
-assert np.all(field.unsafe[free & road]) and not np.any(field.unsafe[free & ~road])
+road = (city.road_length > road_min_m)[:, :, None]
+no_road = (city.road_length == 0)[:, :, None]
+assert np.all(field.unsafe[free & road]) and not np.any(field.unsafe[free & no_road])
+slivers = (city.road_length > 0) & (city.road_length <= road_min_m)
+print(f"road columns: {(city.road_length > 0).sum()}, of which slivers of at most {road_min_m:.3f} m: {slivers.sum()}")
 ports = {v.name: np.array([v.x, v.y]) for v in scenario.network.vertiports}
 ua.plotting.risk(field, vertiports=scenario.network.vertiports, cruise_altitude_m=scenario.network.cruise_altitude_m,
                  title=scenario.name)"""),
