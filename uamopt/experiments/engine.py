@@ -56,7 +56,7 @@ def connect(scheduler: str | None, workers: int | None, tasks: int):
                               "start one with `dask scheduler`, check the address, or drop --scheduler") from None
     n = workers or max(1, min(os.cpu_count() or 1, tasks))
     cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, host="127.0.0.1",
-                           dashboard_address=":0", silence_logs=logging.ERROR)  # any free port: never a clash on 8787
+                           dashboard_address="127.0.0.1:0", silence_logs=logging.ERROR)  # a free loopback port
     return Client(cluster), cluster
 
 
