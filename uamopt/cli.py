@@ -174,7 +174,7 @@ def build_parser() -> argparse.ArgumentParser:
     verify.add_argument("dir", help="folder with flights.json and schedule.csv")
     verify.set_defaults(func=cmd_verify)
     command("reproduce", cmd_reproduce, "run every stage that applies and write report.md with figures", "out/reproduce")
-    from uamopt.experiments.engine import add_sweep_command
+    from uamopt.experiments.commands import add_sweep_command
     from uamopt.export.cli import add_export_commands
 
     add_sweep_command(sub)
