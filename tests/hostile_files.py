@@ -140,8 +140,11 @@ def write_profiles(d: Path) -> None:
                 "nan_limit": 'solver = "greedy"\ntime_limit_s = nan\n', "no_threads": 'solver = "greedy"\nthreads = 0\n',
                 "malformed": "solver = [\n", "seed_word": 'solver = "greedy"\nseed = "x"\n',
                 "options_number": 'solver = "greedy"\noptions = 5\n'}
+    profiles |= {"seed_negative": 'solver = "greedy"\nseed = -1\n', "seed_bool": 'solver = "greedy"\nseed = true\n',
+                 "deep": "a = " + "[" * 100_000 + "]" * 100_000 + "\n"}
     for name, text in profiles.items():
         (d / f"profile_{name}.toml").write_text(text, encoding="utf-8")
+    (d / "profile_latin1.toml").write_bytes(b'solver = "gr\xe9edy"\n')
 
 
 def write_networks(d: Path) -> None:

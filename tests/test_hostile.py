@@ -113,12 +113,14 @@ CASES = [
     ("export-summary-list", "export bluesky {d}/sched_summary_list", 2, "JSON object"),
     ("export-summary-deep", "export geojson {d}/sched_summary_deep", 2, "malformed JSON"),
     ("export-no-schedule", "export bluesky {d}/sched_no_schedule", 2, "missing schedule.csv"),
-    # --- solver profiles (what passes on main; the lead adds option and seed cases) ------------
+    # --- solver profiles ------------------------------------------------------------------------
     *[(f"profile-{name.replace('_', '-')}", f"{SCHED.replace('greedy', '{d}/profile_' + name + '.toml')} --out {{out}}",
        2, fragment) for name, fragment in (
         ("unknown_key", "unknown key 'foo'"), ("no_solver", "missing key 'solver'"), ("bad_solver", "unknown solver"),
         ("negative_limit", "time_limit_s"), ("nan_limit", "time_limit_s"), ("no_threads", "threads"),
-        ("malformed", "malformed TOML"), ("seed_word", "invalid value"), ("options_number", "invalid value"))],
+        ("malformed", "malformed TOML"), ("seed_word", "seed must be an integer"),
+        ("options_number", "[options] must be a table"), ("seed_negative", "seed must be an integer"),
+        ("seed_bool", "seed must be an integer"), ("latin1", "UTF-8"), ("deep", "cannot read the profile"))],
     ("profile-missing", SCHED.replace("greedy", "nowhere") + " --out {out}", 2, "solver profile not found"),
     # --- network files (--network) ------------------------------------------------------------
     *[(f"network-{name.replace('_', '-')}", SCHED + f" --network {{d}}/net_{name}.json --out {{out}}", 2, fragment)

@@ -101,11 +101,12 @@ def checked_network(scenario: Scenario, network_file):
     import math
 
     from uamopt.io import load_network
+    from uamopt.pipeline import scenario_grid
     from uamopt.schedule.airspace import check_tracks
 
     network = load_network(network_file)
     cell = network.cell if all(math.isfinite(c) for c in network.cell) else scenario.grid.cell
-    check_tracks(scenario, network.waypoints(), cell, f"--network {network_file}", "route")
+    check_tracks(scenario, scenario_grid(scenario).extent, network.waypoints(), cell, f"--network {network_file}", "route")
     return network
 
 
@@ -121,8 +122,10 @@ def scenario_flights(scenario: Scenario, flights_file=None, network_file=None, s
         scenario.network.route_list()  # a network without routes is refused before anything is computed
     network = checked_network(scenario, network_file) if network_file else None
     if flights_file:
-        flights = load_flights(flights_file, scenario, scenario_grid(scenario), network and network.waypoints())
-        check_tracks(scenario, {f.id: f.waypoints for f in flights.flights}, flights.cell, str(flights_file), "flight")
+        grid = scenario_grid(scenario)
+        flights = load_flights(flights_file, scenario, grid, network and network.waypoints())
+        check_tracks(scenario, grid.extent, {f.id: f.waypoints for f in flights.flights}, flights.cell, str(flights_file),
+                     "flight")
         return flights
     if network is None:
         network = plan_network(planning_model(scenario, compute_risk(scenario)))

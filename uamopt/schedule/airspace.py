@@ -41,13 +41,16 @@ def _points(waypoints: np.ndarray, cell: tuple[float, float, float]) -> np.ndarr
     return np.vstack([a[seg] + u[:, None] * (b - a)[seg], waypoints[-1:]])
 
 
-def check_tracks(scenario: Scenario, tracks: Mapping[str, np.ndarray], cell, source: str, kind: str = "route") -> None:
+def check_tracks(scenario: Scenario, extent, tracks: Mapping[str, np.ndarray], cell, source: str,
+                 kind: str = "route") -> None:
     """Refuse a track outside the grid, at or below the ground, or inside a building (module docstring).
 
     Parameters
     ----------
     scenario : Scenario
-        Supplies the grid's extent, the city and ``network.tracks``.
+        Supplies the city and ``network.tracks``.
+    extent : (x_max, y_max, z_max)
+        The scenario's grid, m (``uamopt.pipeline.scenario_grid(scenario).extent``).
     tracks : mapping name -> (n, 3) waypoints, m
         Routes of a network file or flights of a flights file.
     cell : (Δx, Δy, Δz)
@@ -64,12 +67,11 @@ def check_tracks(scenario: Scenario, tracks: Mapping[str, np.ndarray], cell, sou
     """
     from uamopt.city import load_city
     from uamopt.grid.grid import file_grid
-    from uamopt.pipeline import scenario_grid
 
     def where(name: str) -> str:
         return f"{source}: {kind} {name}"
 
-    extent = np.asarray(scenario_grid(scenario).extent)
+    extent = np.asarray(extent, dtype=float)
     unique: dict[bytes, tuple[str, np.ndarray]] = {}
     for name, w in tracks.items():  # flights on one route share a track: check it once, name the first
         unique.setdefault(np.asarray(w, dtype=float).tobytes(), (name, np.asarray(w, dtype=float)))
