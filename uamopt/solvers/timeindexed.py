@@ -294,10 +294,10 @@ def _cpsat(model: GridModel, problem: SchedulingProblem, deadline: float, thread
            hint: np.ndarray | None) -> EngineResult:
     from ortools.sat.python import cp_model
 
-    from uamopt.solvers.cpsat import _bound, _objective
+    from uamopt.solvers.cpsat import integer_objective, objective_bound
 
     k_max = np.diff(model.start) - 1
-    per_unit, per_flight, divisor, how = _objective(problem, model.step_s, k_max)
+    per_unit, per_flight, divisor, how = integer_objective(problem, model.step_s, k_max)
     m = cp_model.CpModel()
     x = [m.new_bool_var(f"x{j}") for j in range(model.n_cols)]
     for r in range(len(model.row_ptr) - 1):
@@ -329,7 +329,7 @@ def _cpsat(model: GridModel, problem: SchedulingProblem, deadline: float, thread
     code = solver.solve(m, _Times())
     has = code in (cp_model.OPTIMAL, cp_model.FEASIBLE)
     values = np.array([solver.boolean_value(v) for v in x], dtype=float) if has else None
-    bound = _bound(problem, solver.best_objective_bound, per_flight, divisor, model.step_s, how)
+    bound = objective_bound(problem, solver.best_objective_bound, per_flight, divisor, model.step_s, how)
     return EngineResult(x=values, bound=bound, proved=code == cp_model.OPTIMAL, termination=solver.status_name(code),
                         seconds=float(solver.wall_time), first_incumbent_s=found[0] if found else None,
                         best_incumbent_s=found[-1] if found else None)
