@@ -67,3 +67,12 @@ def test_the_command_line_parser_loads_no_heavy_library():
             " if m in sys.modules))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, cwd=ROOT)
     assert out.stdout.strip() == "[]"
+
+
+@pytest.mark.parametrize("path", sorted((ROOT / "uamopt").rglob("*.py")), ids=lambda p: str(p.relative_to(ROOT)))
+def test_no_module_imports_another_modules_private_names(path):
+    """What one module needs of another is public there (docs/house.md): no ``from uamopt.x import _y``."""
+    private = [f"{node.module}.{a.name} (line {node.lineno})" for node in ast.walk(ast.parse(path.read_text(encoding="utf-8")))
+               if isinstance(node, ast.ImportFrom) and (node.module or "").startswith("uamopt")
+               for a in node.names if a.name.startswith("_") and not a.name.startswith("__")]
+    assert not private, f"{path.relative_to(ROOT)} imports private names: {private}"

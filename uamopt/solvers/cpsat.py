@@ -49,7 +49,7 @@ ROUND_S = 1e-9  # float round-off accepted when rounding a real time to units, s
 INT_LIMIT = 2**62  # keep |objective| below this (CP-SAT uses int64)
 
 
-def _objective(problem: SchedulingProblem, unit_s: float, delay_max: np.ndarray) -> tuple[int, int, float, str]:
+def integer_objective(problem: SchedulingProblem, unit_s: float, delay_max: np.ndarray) -> tuple[int, int, float, str]:
     """Integer coefficients (per unit of delay, per operated flight) of ``problem.objective``, the
     divisor back to W, and how."""
     total = int(delay_max.sum()) + 1
@@ -112,12 +112,12 @@ def build_cpsat(problem: SchedulingProblem, unit_s: float = 0.01, rounding: str 
             model.add_bool_or([operate[p].Not(), operate[q].Not()])
         elif allowed.size() < reach.size():
             model.add_linear_expression_in_domain(delay[q] - delay[p], allowed).only_enforce_if([operate[p], operate[q]])
-    per_unit, per_flight, divisor, how = _objective(problem, unit_s, delay_max)
+    per_unit, per_flight, divisor, how = integer_objective(problem, unit_s, delay_max)
     model.minimize(per_unit * sum(delay) - per_flight * sum(operate))
     return model, operate, delay, per_unit, per_flight, divisor, how
 
 
-def _bound(problem: SchedulingProblem, raw: float, per_flight: int, divisor: float, unit_s: float, how: str) -> float:
+def objective_bound(problem: SchedulingProblem, raw: float, per_flight: int, divisor: float, unit_s: float, how: str) -> float:
     """CP-SAT's integer bound as a bound of W (weighted) or of model.py's lexicographic scalar."""
     if how != "lexicographic":
         return raw / divisor
@@ -203,7 +203,7 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
     delay_k = [solver.value(v) for v in delay]
     delay_s = np.array(delay_k, dtype=float) * unit_s
     status = "optimal" if code == cp_model.OPTIMAL else "time_limit"  # FEASIBLE: stopped by the time limit
-    bound = _bound(problem, solver.best_objective_bound, per_flight, divisor, unit_s, how)
+    bound = objective_bound(problem, solver.best_objective_bound, per_flight, divisor, unit_s, how)
     schedule = no_worse(problem, make_schedule(problem, "cpsat", status, operated, delay_s, bound=bound,
                                                solve_seconds=seconds, seed=profile.seed, extras=extras), start)
     if want_bound and profile.time_limit_s - (time.perf_counter() - t0) > 0.5:
@@ -215,7 +215,7 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
         relaxed = _solver(profile, options, left)
         r_code = relaxed.solve(inner)
         if r_code in (cp_model.OPTIMAL, cp_model.FEASIBLE, cp_model.UNKNOWN):
-            low = _bound(problem, relaxed.best_objective_bound, i_flight, i_div, unit_s, i_how)
+            low = objective_bound(problem, relaxed.best_objective_bound, i_flight, i_div, unit_s, i_how)
             schedule.extras.update(continuous_bound=low, continuous_bound_termination=relaxed.status_name(r_code),
                                    continuous_bound_model=f"delay cells {unit_s:g} s (relaxation of the continuous model)",
                                    optimal_within=schedule.objective - low)

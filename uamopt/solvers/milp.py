@@ -47,6 +47,7 @@ from pyomo.contrib.solver.common.results import SolutionStatus, TerminationCondi
 from uamopt.errors import UamoptError
 from uamopt.schedule.flights import TIME_TOL_S
 from uamopt.schedule.model import Schedule, SchedulingProblem, make_schedule
+from uamopt.solvers.deadline import interrupt_at
 
 SOLVER_NAME = "highs"  # Pyomo 6.10.x name of the HiGHS interface (newer upstream: "highs_persistent")
 
@@ -224,6 +225,9 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
     build_s = time.perf_counter() - t0
     solver.set_instance(m)  # the persistent interface: load the model, then hand HiGHS the MIP start
     _set_mip_start(solver, mip_start(m, problem, start.operated, start.delay_s))
+    stopped: list = []
+    if getattr(solver, "_solver_model", None) is not None:  # pyomo 6.10's persistent HiGHS object
+        stopped = interrupt_at(solver._solver_model, t0 + profile.time_limit_s)  # where HiGHS listens (deadline.py)
     left = profile.time_limit_s - (time.perf_counter() - t0)
     if left <= 0.05:
         return _start_only(problem, profile, start, t0, f"the time limit ran out while building the MILP ({build_s:.1f} s)")
@@ -246,7 +250,8 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
                              seed=profile.seed, extras=extras)
     if tc == TerminationCondition.convergenceCriteriaSatisfied and has_solution:
         status = "optimal"
-    elif tc in (TerminationCondition.maxTimeLimit, TerminationCondition.iterationLimit, TerminationCondition.interrupted):
+    elif tc in (TerminationCondition.maxTimeLimit, TerminationCondition.iterationLimit, TerminationCondition.interrupted
+                ) or (stopped and tc == TerminationCondition.unknown):  # our deadline interrupt (deadline.py)
         status = "time_limit"
     else:
         raise UamoptError(f"HiGHS stopped with {tc.name}", f"solver {profile.name or 'highs'}", "see the HiGHS log (tee=True)")

@@ -68,6 +68,7 @@ import numpy as np
 from uamopt.errors import UamoptError
 from uamopt.schedule.flights import TIME_TOL_S
 from uamopt.schedule.model import Schedule, SchedulingProblem, make_schedule
+from uamopt.solvers.deadline import highs_can_start, interrupt_at
 from uamopt.solvers.warmstart import Start, no_worse, reduced, warm_start
 
 ETA_S = 1e-9  # float round-off accepted when rounding a time to grid steps, s
@@ -218,14 +219,18 @@ class EngineResult:
     best_incumbent_s: float | None = None
 
 
-def _highs(model: GridModel, limit_s: float, threads: int, seed: int, gap: float, hint: np.ndarray | None,
+def _left(deadline: float) -> float:
+    """Seconds to ``deadline`` (a ``time.perf_counter`` time), at least 0.05."""
+    return max(0.05, deadline - time.perf_counter())
+
+
+def _highs(model: GridModel, deadline: float, threads: int, seed: int, gap: float, hint: np.ndarray | None,
            presolve: bool = True) -> EngineResult:
     import highspy
 
     h = highspy.Highs()
     h.resetGlobalScheduler(True)  # HiGHS keeps one thread pool per process: a new thread count needs a new pool
     h.setOptionValue("output_flag", False)
-    h.setOptionValue("time_limit", float(limit_s))
     h.setOptionValue("threads", int(threads))
     h.setOptionValue("random_seed", int(seed))
     h.setOptionValue("mip_rel_gap", float(gap))
@@ -255,6 +260,8 @@ def _highs(model: GridModel, limit_s: float, threads: int, seed: int, gap: float
         h.addRows(len(spans), np.ones(len(spans)), np.full(len(spans), inf), len(cols), ptr, cols, np.ones(len(cols)))
     if hint is not None:
         h.setSolution(_solution(highspy, hint))
+    h.setOptionValue("time_limit", _left(deadline))  # what the model's loading left of the limit
+    interrupt_at(h, deadline)  # HiGHS's own limit is not checked everywhere (deadline.py)
     t0 = time.perf_counter()
     found: list[float] = []  # times of HiGHS's improving solutions
     h.cbMipImprovingSolution.subscribe(lambda *_: found.append(time.perf_counter() - t0))
@@ -267,7 +274,7 @@ def _highs(model: GridModel, limit_s: float, threads: int, seed: int, gap: float
     x = np.array(sol.col_value) if sol.value_valid else None
     if hint is not None and x is not None and abs(float(model.cost @ x) - info.objective_function_value) > 1e-6 * (
             1.0 + abs(info.objective_function_value)):  # a solution that is not the one reported: trust neither
-        return _highs(model, limit_s, threads, seed, gap, None, presolve)
+        return _highs(model, deadline, threads, seed, gap, None, presolve)
     proved = status == highspy.HighsModelStatus.kOptimal
     bound = float(info.mip_dual_bound) if math.isfinite(info.mip_dual_bound) else None
     if proved and x is not None:
@@ -283,18 +290,21 @@ def _solution(highspy, x: np.ndarray):
     return sol
 
 
-def _cpsat(model: GridModel, problem: SchedulingProblem, limit_s: float, threads: int, seed: int, gap: float,
+def _cpsat(model: GridModel, problem: SchedulingProblem, deadline: float, threads: int, seed: int, gap: float,
            hint: np.ndarray | None) -> EngineResult:
     from ortools.sat.python import cp_model
 
-    from uamopt.solvers.cpsat import _bound, _objective
+    from uamopt.solvers.cpsat import integer_objective, objective_bound
 
     k_max = np.diff(model.start) - 1
-    per_unit, per_flight, divisor, how = _objective(problem, model.step_s, k_max)
+    per_unit, per_flight, divisor, how = integer_objective(problem, model.step_s, k_max)
     m = cp_model.CpModel()
     x = [m.new_bool_var(f"x{j}") for j in range(model.n_cols)]
     for r in range(len(model.row_ptr) - 1):
         m.add_at_most_one([x[j] for j in model.row_col[model.row_ptr[r]:model.row_ptr[r + 1]].tolist()])
+        if r % 20000 == 19999 and time.perf_counter() > deadline:  # the limit ran out while loading the model
+            return EngineResult(x=None, bound=None, proved=False, termination="not run (the limit ran out building)",
+                                seconds=0.0)
     for f, r in model.prec.tolist():
         m.add(sum(x[model.start[f]:model.start[f + 1]]) <= sum(x[model.start[r]:model.start[r + 1]]))
     for f in model.must.tolist():
@@ -306,7 +316,7 @@ def _cpsat(model: GridModel, problem: SchedulingProblem, limit_s: float, threads
         for j in range(model.n_cols):
             m.add_hint(x[j], bool(hint[j] > 0.5))
     solver = cp_model.CpSolver()
-    solver.parameters.max_time_in_seconds = float(limit_s)
+    solver.parameters.max_time_in_seconds = _left(deadline)
     solver.parameters.num_workers = int(threads)
     solver.parameters.random_seed = int(seed)
     solver.parameters.relative_gap_limit = float(gap)
@@ -319,7 +329,7 @@ def _cpsat(model: GridModel, problem: SchedulingProblem, limit_s: float, threads
     code = solver.solve(m, _Times())
     has = code in (cp_model.OPTIMAL, cp_model.FEASIBLE)
     values = np.array([solver.boolean_value(v) for v in x], dtype=float) if has else None
-    bound = _bound(problem, solver.best_objective_bound, per_flight, divisor, model.step_s, how)
+    bound = objective_bound(problem, solver.best_objective_bound, per_flight, divisor, model.step_s, how)
     return EngineResult(x=values, bound=bound, proved=code == cp_model.OPTIMAL, termination=solver.status_name(code),
                         seconds=float(solver.wall_time), first_incumbent_s=found[0] if found else None,
                         best_incumbent_s=found[-1] if found else None)
@@ -327,17 +337,24 @@ def _cpsat(model: GridModel, problem: SchedulingProblem, limit_s: float, threads
 
 def run_engine(engine: str, model: GridModel, problem: SchedulingProblem, limit_s: float, threads: int, seed: int,
                gap: float = 0.0, hint: np.ndarray | None = None) -> EngineResult:
-    """Solve a :class:`GridModel` with HiGHS or CP-SAT."""
+    """Solve a :class:`GridModel` with HiGHS or CP-SAT within ``limit_s`` seconds, loading the model
+    into the solver included."""
+    deadline = time.perf_counter() + limit_s
+    if engine == "highs" and not highs_can_start(model.n_rows, limit_s):
+        return EngineResult(x=None, bound=None, proved=False, seconds=0.0,
+                            termination="not run (HiGHS could not start within the limit: deadline.py)")
     if engine == "highs":
-        return _highs(model, limit_s, threads, seed, gap, hint)
+        return _highs(model, deadline, threads, seed, gap, hint)
     if engine == "cpsat":
-        return _cpsat(model, problem, limit_s, threads, seed, gap, hint)
+        return _cpsat(model, problem, deadline, threads, seed, gap, hint)
+    if engine == "hybrid" and not highs_can_start(model.n_rows, HYBRID_HIGHS_SHARE * limit_s, presolve=False):
+        return _cpsat(model, problem, deadline, threads, seed, gap, hint)  # HiGHS could not even start in its share
     if engine == "hybrid":  # HiGHS without presolve for incumbents, then CP-SAT from its best for the bound
-        first = _highs(model, HYBRID_HIGHS_SHARE * limit_s, threads, seed, gap, hint, presolve=False)
+        first = _highs(model, time.perf_counter() + HYBRID_HIGHS_SHARE * limit_s, threads, seed, gap, hint, presolve=False)
         if first.proved:
             return first
         start = first.x if first.x is not None else hint
-        second = _cpsat(model, problem, (1 - HYBRID_HIGHS_SHARE) * limit_s, threads, seed, gap, start)
+        second = _cpsat(model, problem, deadline, threads, seed, gap, start)
         xs = [r.x for r in (first, second) if r.x is not None]
         x = min(xs, key=lambda v: float(model.cost @ v)) if xs else None
         bounds = [b for b in (first.bound, second.bound) if b is not None]  # both bound the same model
