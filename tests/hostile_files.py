@@ -15,8 +15,8 @@ import shutil
 from pathlib import Path
 
 import numpy as np
-
 from conftest import PAPER_CASE
+
 from uamopt.cli import main
 
 TINY = ("--set", "grid.cell=[250,250,60]")  # 10 x 18 x 6 cells: every command is fast

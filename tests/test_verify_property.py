@@ -22,11 +22,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import PAPER_CASE
+from hostile_files import PORTS
 from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 
-from conftest import PAPER_CASE
-from hostile_files import PORTS
 from uamopt.cli import main
 
 DT_S = 0.25  # sampling step, s

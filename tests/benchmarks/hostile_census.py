@@ -20,10 +20,10 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from hostile_files import write_all  # noqa: E402
-from test_hostile import CASES, _argv, _out, _snapshot  # noqa: E402
+from hostile_files import write_all
+from test_hostile import CASES, _argv, _out, _snapshot
 
-from uamopt.cli import main  # noqa: E402
+from uamopt.cli import main
 
 
 class Hang(Exception):
@@ -36,7 +36,7 @@ def _alarm(signum, frame):
 
 def run_case(case, files: Path, tmp: Path, timeout_s: int = 0) -> list[str]:
     """The faults of one case: 'hang', 'traceback', 'exit code', 'error line', 'torn output'."""
-    name, line, expected, fragment = case
+    _, line, expected, fragment = case
     out = _out(tmp)
     before = _snapshot(files)
     stdout, stderr = io.StringIO(), io.StringIO()
