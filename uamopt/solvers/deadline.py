@@ -1,4 +1,4 @@
-"""Keeping HiGHS to a wall-clock deadline.
+"""Keeping HiGHS to a wall-clock deadline, and quiet.
 
 HiGHS checks its ``time_limit`` only at some points. Measured on the time-indexed model of
 models/benchmark_3000.toml (39,000 columns, 173,000 rows, a loaded 2-core machine): with a 1.5 s
@@ -37,3 +37,24 @@ UNLISTENING_S_PER_ROW = {False: 44e-6, True: 130e-6}
 def highs_can_start(rows: int, seconds_left: float, presolve: bool = True) -> bool:
     """Whether HiGHS's first uninterruptible stretch on a model of ``rows`` rows fits ``seconds_left``."""
     return rows * UNLISTENING_S_PER_ROW[bool(presolve)] <= seconds_left
+
+
+def quiet_highs():
+    """A ``highspy.Highs`` with its output off, made without the banner HiGHS prints on stdout at
+    construction (file descriptor 1 is pointed at /dev/null for that moment)."""
+    import os
+    import sys
+
+    import highspy
+
+    sys.stdout.flush()
+    saved = os.dup(1)
+    try:
+        with open(os.devnull, "w") as null:
+            os.dup2(null.fileno(), 1)
+            highs = highspy.Highs()
+            highs.setOptionValue("output_flag", False)
+    finally:
+        os.dup2(saved, 1)
+        os.close(saved)
+    return highs

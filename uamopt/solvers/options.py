@@ -137,8 +137,9 @@ def check_options(solver: str, options: Any, name: str) -> None:
 def _check_highs(options: dict, where: str) -> None:
     import highspy
 
-    h = highspy.Highs()
-    h.setOptionValue("output_flag", False)
+    from uamopt.solvers.deadline import quiet_highs
+
+    h = quiet_highs()
     for key, value in options.items():
         if isinstance(value, bool) and h.getOptionType(key)[1] != highspy.HighsOptionType.kBool:
             ok = False  # HiGHS would read true as 1

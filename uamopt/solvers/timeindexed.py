@@ -68,7 +68,7 @@ import numpy as np
 from uamopt.errors import UamoptError
 from uamopt.schedule.flights import TIME_TOL_S
 from uamopt.schedule.model import Schedule, SchedulingProblem, make_schedule
-from uamopt.solvers.deadline import highs_can_start, interrupt_at
+from uamopt.solvers.deadline import highs_can_start, interrupt_at, quiet_highs
 from uamopt.solvers.warmstart import Start, no_worse, reduced, warm_start
 
 ETA_S = 1e-9  # float round-off accepted when rounding a time to grid steps, s
@@ -228,7 +228,7 @@ def _highs(model: GridModel, deadline: float, threads: int, seed: int, gap: floa
            presolve: bool = True) -> EngineResult:
     import highspy
 
-    h = highspy.Highs()
+    h = quiet_highs()
     h.resetGlobalScheduler(True)  # HiGHS keeps one thread pool per process: a new thread count needs a new pool
     h.setOptionValue("output_flag", False)
     h.setOptionValue("threads", int(threads))
