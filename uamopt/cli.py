@@ -171,14 +171,37 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _interrupted(args, interrupt: KeyboardInterrupt) -> int:
+    """One line for Ctrl-C or SIGTERM, true about what is in the output folder."""
+    from uamopt.interrupts import describe, exit_code
+    from uamopt.outputs import published
+
+    folder = getattr(args, "out", None) or getattr(args, "dir", None)
+    line = describe(interrupt)
+    if folder:
+        line += (f": the results in {folder} were complete before the interrupt" if published(folder)
+                 else f": nothing was written to {folder}")
+    sys.stderr.write(line + "\n")
+    return exit_code(interrupt)
+
+
 def main(argv: list[str] | None = None) -> int:
-    parser = build_parser()
-    args = parser.parse_args(argv)
+    from uamopt.interrupts import interrupt_of, raise_on_sigterm
+
+    raise_on_sigterm()  # SIGTERM cleans up like Ctrl-C (uamopt.interrupts)
+    try:
+        args = build_parser().parse_args(argv)
+    except KeyboardInterrupt as exc:
+        return _interrupted(None, exc)
     try:
         return args.func(args)
     except UamoptError as exc:
         sys.stderr.write(f"error: {exc.line()}\n")
         return EXIT_BAD_INPUT
-    except KeyboardInterrupt:
-        sys.stderr.write("error: interrupted (keyboard): nothing was written to --out\n")
-        return 130
+    except Exception as exc:
+        interrupt = interrupt_of(exc)  # a library that wrapped the KeyboardInterrupt in its own error
+        if interrupt is None:
+            raise
+        return _interrupted(args, interrupt)
+    except KeyboardInterrupt as exc:
+        return _interrupted(args, exc)
