@@ -177,18 +177,18 @@ def _interrupted(args, interrupt: KeyboardInterrupt) -> int:
     from uamopt.outputs import published
 
     folder = getattr(args, "out", None) or getattr(args, "dir", None)
-    line = describe(interrupt)
+    line = describe(interrupt) + ": nothing was written"  # args None: before the command line was read
     if folder:
-        line += (f": the results in {folder} were complete before the interrupt" if published(folder)
-                 else f": nothing was written to {folder}")
+        line = (f"{describe(interrupt)}: the results in {folder} were complete before the interrupt" if published(folder)
+                else f"{line} to {folder}")
     sys.stderr.write(line + "\n")
     return exit_code(interrupt)
 
 
 def main(argv: list[str] | None = None) -> int:
-    from uamopt.interrupts import interrupt_of, raise_on_sigterm
+    from uamopt.interrupts import install_handlers, interrupt_of
 
-    raise_on_sigterm()  # SIGTERM cleans up like Ctrl-C (uamopt.interrupts)
+    install_handlers()  # SIGTERM cleans up like Ctrl-C (uamopt.interrupts)
     try:
         args = build_parser().parse_args(argv)
     except KeyboardInterrupt as exc:

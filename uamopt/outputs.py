@@ -24,7 +24,6 @@ after the first entry has moved, so a test can interrupt exactly there (tests/te
 from __future__ import annotations
 
 import errno
-import fcntl
 import json
 import os
 import re
@@ -42,6 +41,11 @@ import numpy as np
 
 from uamopt.errors import UamoptError
 from uamopt.interrupts import deferred_signals
+
+try:
+    import fcntl
+except ImportError:  # not POSIX (Windows): staging and the atomic move work, the lock does not
+    fcntl = None
 
 LOCK_SUFFIX = ".uamopt.lock"
 STAGE_TAG = ".uamopt-stage-"
@@ -122,7 +126,8 @@ def _acquire(lock_path: Path, out: Path, option: str) -> int:
         except OSError as exc:
             raise _cannot_write(exc, lock_path.parent, option) from None
         try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            if fcntl is not None:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:
             os.close(fd)
             raise UamoptError(f"another uamopt run is writing to {out}", option,

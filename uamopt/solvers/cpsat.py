@@ -42,6 +42,7 @@ from fractions import Fraction
 import numpy as np
 
 from uamopt.errors import UamoptError
+from uamopt.interrupts import stopping
 from uamopt.schedule.flights import TIME_TOL_S
 from uamopt.schedule.model import Schedule, SchedulingProblem, make_schedule
 
@@ -131,6 +132,7 @@ def _solver(profile, options: dict, limit_s: float):
     solver.parameters.max_time_in_seconds = float(limit_s)
     solver.parameters.num_workers = int(profile.threads)
     solver.parameters.random_seed = int(profile.seed)
+    solver.parameters.catch_sigint_signal = False  # its own Ctrl-C handler swallows the interrupt (uamopt.interrupts)
     # CP-SAT's default small portfolios carry no max-LP worker and cannot close the bound of the
     # paper case in 60 s; with the big-M linear relaxation (level 2) they prove it in about 1 s
     options = dict(options)
@@ -182,7 +184,8 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
         model.add_hint(operate[f], bool(start.operated[f]))
         model.add_hint(delay[f], int(np.rint(start.delay_s[f] / unit_s)) if start.operated[f] else 0)
     solver = _solver(profile, options, profile.time_limit_s)
-    code = solver.solve(model)
+    with stopping(solver.stop_search):  # Ctrl-C and SIGTERM stop the search at once
+        code = solver.solve(model)
     seconds = float(solver.wall_time)
     n = problem.n_flights
     extras = {"termination": solver.status_name(code), "time_unit_s": unit_s, "objective_scale": how,

@@ -34,12 +34,15 @@ Profile options: ``mip_rel_gap`` (default 0.0); every other key goes to HiGHS un
 
 from __future__ import annotations
 
+import logging
+
 import numpy as np
 import pyomo.environ as pyo
 from pyomo.contrib.solver.common.factory import SolverFactory
 from pyomo.contrib.solver.common.results import SolutionStatus, TerminationCondition
 
 from uamopt.errors import UamoptError
+from uamopt.interrupts import stopping
 from uamopt.schedule.flights import TIME_TOL_S
 from uamopt.schedule.model import Schedule, SchedulingProblem, make_schedule
 
@@ -227,13 +230,15 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
         raise UamoptError("HiGHS is not available to Pyomo", f"solver {profile.name or 'highs'}", "pip install highspy")
     solver.set_instance(m)  # the persistent interface: load the model, then hand HiGHS the MIP start
     _set_mip_start(solver, mip_start(m, problem, start.operated, start.delay_s))
-    result = solver.solve(m, time_limit=float(profile.time_limit_s), threads=int(profile.threads), solver_options=options,
-                          load_solutions=False, raise_exception_on_nonoptimal_result=False)
+    with stopping(cancel(solver)):  # Ctrl-C and SIGTERM stop HiGHS at once
+        result = solver.solve(m, time_limit=float(profile.time_limit_s), threads=int(profile.threads),
+                              solver_options=options, load_solutions=False, raise_exception_on_nonoptimal_result=False)
     if _stale_solution(m, result):  # highspy 1.16: the start's values beside a better objective; solve cold
         m = build_model(reduced(problem))
-        result = SolverFactory(SOLVER_NAME).solve(m, time_limit=float(profile.time_limit_s), threads=int(profile.threads),
-                                                  solver_options=options, load_solutions=False,
-                                                  raise_exception_on_nonoptimal_result=False)
+        solver = SolverFactory(SOLVER_NAME)
+        with stopping(cancel(solver)):
+            result = solver.solve(m, time_limit=float(profile.time_limit_s), threads=int(profile.threads),
+                                  solver_options=options, load_solutions=False, raise_exception_on_nonoptimal_result=False)
     tc, has_solution = result.termination_condition, result.solution_status in (SolutionStatus.optimal, SolutionStatus.feasible)
     seconds = float(result.timing_info.wall_time or 0.0)
     extras = {"termination": tc.name, "nodes": getattr(result.extra_info, "mip_node_count", None),
@@ -263,6 +268,16 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
     extras["model"] = "continuous delays (the exact MILP of Eqs. 20-31)"
     return no_worse(problem, make_schedule(problem, "highs", status, operated, delay, bound=bound, solve_seconds=seconds,
                                            seed=profile.seed, extras=extras), start)
+
+
+def cancel(solver):
+    """What stops Pyomo's HiGHS ``solver`` mid-solve (uamopt.interrupts.stopping): its highspy model,
+    which exists once the solve has begun. Pyomo's warning about the interrupted status is muted."""
+    def stop() -> None:
+        logging.getLogger(type(solver).__module__).setLevel(logging.ERROR)
+        solver._solver_model.cancelSolve()
+
+    return stop
 
 
 def _stale_solution(m: pyo.ConcreteModel, result) -> bool:

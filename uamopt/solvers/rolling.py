@@ -61,6 +61,7 @@ import time
 import numpy as np
 
 from uamopt.errors import UamoptError
+from uamopt.interrupts import stopping
 from uamopt.schedule.flights import TIME_TOL_S
 from uamopt.schedule.model import Schedule, SchedulingProblem, make_schedule, violations
 from uamopt.schedule.occupancy import ConflictTable
@@ -178,11 +179,13 @@ def _inner_cpsat(sub: SchedulingProblem, fixed: np.ndarray, hint: tuple[np.ndarr
     solver.parameters.max_time_in_seconds = float(limit_s)
     solver.parameters.num_workers = int(threads)
     solver.parameters.random_seed = int(seed)
+    solver.parameters.catch_sigint_signal = False  # its own Ctrl-C handler swallows the interrupt (uamopt.interrupts)
     if threads == 1:
         solver.parameters.linearization_level = 2
     else:
         solver.parameters.subsolvers.extend(["max_lp", "default_lp"])
-    code = solver.solve(model)
+    with stopping(solver.stop_search):
+        code = solver.solve(model)
     if code not in (cp_model.OPTIMAL, cp_model.FEASIBLE):
         return None
     operated = np.array([solver.boolean_value(v) for v in operate])
@@ -201,9 +204,11 @@ def _inner_highs(sub: SchedulingProblem, fixed: np.ndarray, limit_s: float, thre
     m = milp.build_model(sub)
     for i in np.flatnonzero(fixed).tolist():
         m.operate[i].fix(1)  # the "must operate" extension
-    result = SolverFactory(milp.SOLVER_NAME).solve(
-        m, time_limit=float(limit_s), threads=int(threads), solver_options={"mip_rel_gap": 0.0, "random_seed": int(seed)},
-        load_solutions=False, raise_exception_on_nonoptimal_result=False)
+    solver = SolverFactory(milp.SOLVER_NAME)
+    with stopping(milp.cancel(solver)):
+        result = solver.solve(m, time_limit=float(limit_s), threads=int(threads),
+                              solver_options={"mip_rel_gap": 0.0, "random_seed": int(seed)}, load_solutions=False,
+                              raise_exception_on_nonoptimal_result=False)
     if result.solution_status not in (SolutionStatus.optimal, SolutionStatus.feasible):
         return None
     result.solution_loader.load_vars()
