@@ -178,7 +178,7 @@ def test_a_second_run_into_the_same_folder_is_refused_at_once(tmp_path):
     stops before doing anything while the first holds the folder (until it has verified)."""
     tmpdir, out = tmp_path / "tmp", tmp_path / "sched"
     tmpdir.mkdir()
-    first = Run(["schedule", PAPER, "--solver", "greedy", "--out", out], tmpdir, pause_s=3)
+    first = Run(["schedule", PAPER, "--solver", "greedy", "--out", out], tmpdir, pause_s=2.5)
     first.wait_for(PAUSE_ENV)
     second = Run(["schedule", PAPER, "--solver", "greedy", "--out", out], tmpdir)
     code, stdout, stderr = second.finish()
@@ -190,6 +190,65 @@ def test_a_second_run_into_the_same_folder_is_refused_at_once(tmp_path):
     assert code == 0 and "Traceback" not in stderr
     schedule_complete(out)
     assert leftovers(out) == [] and list(tmpdir.iterdir()) == []
+
+
+@pytest.mark.slow
+def test_ctrl_c_in_a_sweep_keeps_the_finished_cases_and_prints_no_traceback(tmp_path):
+    """Ctrl-C reaches the Dask worker processes too, which printed tracebacks; they ignore it now
+    and the sweep stops them. The finished cases stay; TMPDIR (the cluster's scratch) is clean."""
+    tmpdir, out = tmp_path / "tmp", tmp_path / "sweep"
+    tmpdir.mkdir()
+    run = Run(["sweep", ROOT / "tests/data/sweeps/tiny.toml", "--out", out, "--workers", 2], tmpdir)
+    deadline = time.monotonic() + 120
+    while not list((out / "parts").glob("*.parquet")):
+        assert run.proc.poll() is None and time.monotonic() < deadline, "".join(run.stderr)
+        time.sleep(0.01)
+    run.send(signal.SIGINT)
+    code, _, stderr = run.finish()
+    assert code == 130 and "Traceback" not in stderr, stderr
+    assert f"interrupted: finished cases are saved in {out}: re-run the same command to finish\n" in stderr
+    assert list((out / "parts").glob("*.parquet")) and not (out / "results.parquet").exists()
+    assert leftovers(out) == [] and list(tmpdir.iterdir()) == []
+
+
+HOLD = """import sys, time
+from uamopt.outputs import output_lock
+with output_lock(sys.argv[1]):
+    print("held", flush=True)
+    time.sleep(60)
+"""
+
+
+def test_a_sweep_into_a_folder_in_use_is_refused(tmp_path, capsys):
+    """The results folder of a sweep is locked like any --out (another process holds it here)."""
+    out = tmp_path / "sweep"
+    holder = subprocess.Popen([sys.executable, "-c", HOLD, str(out)], stdout=subprocess.PIPE, text=True)
+    try:
+        assert holder.stdout.readline() == "held\n"
+        assert main(["sweep", str(ROOT / "tests/data/sweeps/tiny.toml"), "--out", str(out)]) == 2
+    finally:
+        holder.kill()
+        holder.wait()
+    assert capsys.readouterr().err == (f"error: another uamopt run is writing to {out} (--out): wait for it to finish, "
+                                       "or choose another folder\n")
+    assert not out.exists()
+
+
+@pytest.mark.slow
+def test_the_next_run_clears_what_a_killed_run_left(tmp_path):
+    """SIGKILL cannot be caught: the run's staging folder and lock file stay beside --out until
+    the next run into the same folder, which takes the (released) lock and removes them."""
+    tmpdir, out = tmp_path / "tmp", tmp_path / "risk"
+    tmpdir.mkdir()
+    run = Run(["risk", PAPER, *TINY, "--no-figures", "--out", out], tmpdir, pause_s=30)
+    run.wait_for(PAUSE_ENV)
+    run.send(signal.SIGKILL)
+    assert run.finish()[0] == -signal.SIGKILL
+    left = leftovers(out)
+    assert sorted(name.split("-stage-")[0] for name in left) == [".risk.uamopt", ".risk.uamopt.lock"] and not out.exists()
+    assert main(["risk", str(PAPER), *TINY, "--no-figures", "--out", str(out)]) == 0
+    risk_complete(out, figures=False)
+    assert leftovers(out) == []
 
 
 def test_a_users_folder_is_never_replaced(tmp_path, capsys):

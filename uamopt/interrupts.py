@@ -10,7 +10,6 @@ or 143 (SIGTERM): docs/interfaces.md.
 
 from __future__ import annotations
 
-import _thread
 import os
 import signal
 import sys
@@ -38,7 +37,7 @@ def _unraisable_hook(default):
             # only print it and go on: signal the main thread again a moment later, from a timer,
             # so that it surfaces in the command's own code (or here again, until it does).
             signum = signal.SIGTERM if isinstance(interrupt, Terminated) else signal.SIGINT
-            timer = threading.Timer(0.05, _thread.interrupt_main, args=(signum,))
+            timer = threading.Timer(0.05, signal.pthread_kill, args=(threading.main_thread().ident, signum))
             timer.daemon = True
             timer.start()
             return

@@ -32,7 +32,7 @@ import sys
 import tempfile
 import time
 from collections.abc import Iterator
-from contextlib import contextmanager
+from contextlib import contextmanager, suppress
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -53,13 +53,12 @@ PAUSE_ENV = "UAMOPT_TEST_PAUSE_IN_MOVE"
 _NO_SPACE = {errno.ENOSPC, errno.EDQUOT, errno.EFBIG}  # disk full, quota, file size limit
 
 
-@dataclass
+@dataclass(frozen=True)
 class _Lock:
     fd: int
     path: Path
     site: Path  # the folder holding the lock file and the staging folders
     prefix: str  # ".NAME" beside --out, "" inside it
-    depth: int = 1
 
 
 _held: dict[Path, _Lock] = {}  # real path of a locked output folder -> its lock (this process)
@@ -137,8 +136,6 @@ def _acquire(lock_path: Path, out: Path, option: str) -> int:
         except FileNotFoundError:
             current = None
         if current is not None and os.path.samestat(os.fstat(fd), current):
-            os.ftruncate(fd, 0)
-            os.write(fd, f"{os.getpid()}\n".encode())
             return fd
         os.close(fd)
 
@@ -147,9 +144,10 @@ def _remove_stale(site: Path, prefix: str) -> None:
     """Staging folders of a killed run into the same folder: no live run has one while we hold
     the lock, and the name is uamopt's own."""
     pattern = re.compile(re.escape(prefix + STAGE_TAG) + r"[A-Za-z0-9_]{8}")
-    for path in site.iterdir():
-        if pattern.fullmatch(path.name) and path.is_dir() and not path.is_symlink():
-            shutil.rmtree(path, ignore_errors=True)
+    with suppress(OSError):  # a folder that cannot be listed: nothing to clear
+        for path in site.iterdir():
+            if pattern.fullmatch(path.name) and path.is_dir() and not path.is_symlink():
+                shutil.rmtree(path, ignore_errors=True)
 
 
 @contextmanager
@@ -163,33 +161,28 @@ def output_lock(out_dir: str | Path, option: str = "--out") -> Iterator[Path]:
     """
     out = check_out_dir(out_dir, option)
     real = _real(out)
-    held = _held.get(real)
-    if held is not None:
-        held.depth += 1
-        try:
-            yield out
-        finally:
-            held.depth -= 1
+    if real in _held:
+        yield out
         return
-    created = _make_parents(real.parent, option)
-    # beside --out (same file system, nothing inside it until done); inside it when it exists and
-    # its parent is read-only (``--out .`` in a folder whose parent is not the user's)
-    inside = real.is_dir() and not os.access(real.parent, os.W_OK | os.X_OK)
-    site, prefix = (real, "") if inside else (real.parent, "." + real.name)
+    created: list[Path] = []
+    lock = None
     try:
-        lock = _Lock(_acquire(site / (prefix + LOCK_SUFFIX), out, option), site / (prefix + LOCK_SUFFIX), site, prefix)
-    except BaseException:
-        _remove_empty(created)
-        raise
-    _held[real] = lock
-    try:
-        _remove_stale(site, prefix)
+        with deferred_signals():  # an interrupt here would leave the lock taken and not undone
+            created = _make_parents(real.parent, option)
+            # beside --out (same file system, nothing inside it until done); inside it when it exists
+            # and its parent is read-only (``--out .`` in a folder whose parent is not the user's)
+            inside = real.is_dir() and not os.access(real.parent, os.W_OK | os.X_OK)
+            site, prefix = (real, "") if inside else (real.parent, "." + real.name)
+            path = site / (prefix + LOCK_SUFFIX)
+            lock = _held[real] = _Lock(_acquire(path, out, option), path, site, prefix)
+        _remove_stale(lock.site, lock.prefix)
         yield out
     finally:
         with deferred_signals():
-            del _held[real]
-            lock.path.unlink(missing_ok=True)  # before unlocking: see _acquire
-            os.close(lock.fd)
+            if lock is not None:
+                del _held[real]
+                lock.path.unlink(missing_ok=True)  # before unlocking: see _acquire
+                os.close(lock.fd)
             _remove_empty(created)  # only the parents this run created, and only if still empty
 
 

@@ -19,8 +19,10 @@ from __future__ import annotations
 import logging
 import os
 import shutil
+import signal
 import sys
 import tempfile
+import threading
 from pathlib import Path
 
 from uamopt.errors import UamoptError
@@ -40,11 +42,12 @@ CONNECT_TIMEOUT_S = 3.0
 
 def connect(scheduler: str | None, workers: int | None, tasks: int, scratch: str | None = None):
     """A Dask client: on the cluster at ``scheduler``, or on a new loopback LocalCluster whose
-    workers spill to ``scratch`` (default: Dask's, ``dask-scratch-space`` in TMPDIR).
+    scratch space and TMPDIR are ``scratch`` (default: Dask's, ``dask-scratch-space`` in TMPDIR).
 
     Returns (client, cluster or None). Raises UamoptError when the scheduler cannot be reached
     within CONNECT_TIMEOUT_S.
     """
+    import dask
     from distributed import Client, LocalCluster
 
     if scheduler:
@@ -56,8 +59,20 @@ def connect(scheduler: str | None, workers: int | None, tasks: int, scratch: str
             raise UamoptError(f"cannot reach the Dask scheduler at {scheduler} ({error_line(exc)})", "--scheduler",
                               "start one with `dask scheduler`, check the address, or drop --scheduler") from None
     n = workers or max(1, min(os.cpu_count() or 1, tasks))
-    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, host="127.0.0.1",
-                           dashboard_address=None, silence_logs=logging.ERROR, local_directory=scratch)
+    # Ctrl-C reaches every process of the terminal's group, and the workers printed tracebacks.
+    # Processes started while SIGINT is ignored keep ignoring it, so the workers start so; this
+    # process takes Ctrl-C again once they run, and stops them (a Ctrl-C during the start is lost).
+    main = threading.current_thread() is threading.main_thread()
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN) if main else None
+    try:
+        # every temporary file of the cluster in ``scratch``, removed afterwards even where a worker
+        # was stopped mid-task; worker logs muted (a task's error is in its row)
+        with dask.config.set({"temporary-directory": scratch}):
+            cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, host="127.0.0.1",
+                                   dashboard_address=None, silence_logs=logging.CRITICAL, env={"TMPDIR": scratch})
+    finally:
+        if main:
+            signal.signal(signal.SIGINT, previous)
     return Client(cluster), cluster
 
 

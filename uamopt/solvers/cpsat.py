@@ -132,7 +132,6 @@ def _solver(profile, options: dict, limit_s: float):
     solver.parameters.max_time_in_seconds = float(limit_s)
     solver.parameters.num_workers = int(profile.threads)
     solver.parameters.random_seed = int(profile.seed)
-    solver.parameters.catch_sigint_signal = False  # its own Ctrl-C handler swallows the interrupt (uamopt.interrupts)
     # CP-SAT's default small portfolios carry no max-LP worker and cannot close the bound of the
     # paper case in 60 s; with the big-M linear relaxation (level 2) they prove it in about 1 s
     options = dict(options)
@@ -149,6 +148,7 @@ def _solver(profile, options: dict, limit_s: float):
         except (AttributeError, TypeError, ValueError) as exc:
             raise UamoptError(f"unknown or invalid CP-SAT option '{key}': {exc}", f"profile {profile.name or 'cpsat'}",
                               "see ortools/sat/sat_parameters.proto") from None
+    solver.parameters.catch_sigint_signal = False  # its own Ctrl-C handler swallows the interrupt (uamopt.interrupts)
     return solver
 
 
