@@ -4,8 +4,15 @@ Ctrl-C raises ``KeyboardInterrupt`` in Python; :func:`install_handlers` makes SI
 :class:`Terminated` (a ``KeyboardInterrupt``) the same way, so every ``finally`` clause runs: the
 staging folder is removed and the ``--out`` lock released (uamopt.outputs). Inside
 :func:`deferred_signals` both signals are held and delivered when the block ends, so a publish
-or a clean-up always completes. The CLI turns either into one line and exit code 130 (SIGINT)
-or 143 (SIGTERM): docs/interfaces.md.
+or a clean-up always completes. :func:`stopping` makes a running HiGHS or CP-SAT solve stop at
+once. The CLI turns either signal into one line and exit code 130 (SIGINT) or 143 (SIGTERM):
+docs/interfaces.md.
+
+Where interrupts got lost before: CP-SAT's own SIGINT handler (``catch_sigint_signal``, off in
+uamopt) ended the search, returned its incumbent as if the time limit had come, and left SIGINT
+at its default, so a later Ctrl-C killed the process without clean-up; a KeyboardInterrupt
+raised inside a C callback (numba's compiler calls Python back through ctypes) was printed as
+"Exception ignored" with a traceback and the command went on.
 """
 
 from __future__ import annotations

@@ -72,7 +72,7 @@ def connect(scheduler: str | None, workers: int | None, tasks: int, scratch: str
                                    dashboard_address=None, silence_logs=logging.CRITICAL, env={"TMPDIR": scratch})
     finally:
         if main:
-            signal.signal(signal.SIGINT, previous)
+            signal.signal(signal.SIGINT, signal.SIG_DFL if previous is None else previous)
     return Client(cluster), cluster
 
 
