@@ -182,14 +182,37 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _interrupted(args, interrupt: KeyboardInterrupt) -> int:
+    """One line for Ctrl-C or SIGTERM, true about what is in the output folder."""
+    from uamopt.interrupts import describe, exit_code
+    from uamopt.outputs import published
+
+    folder = getattr(args, "out", None) or getattr(args, "dir", None)
+    line = describe(interrupt) + ": nothing was written"  # args None: before the command line was read
+    if folder:
+        line = (f"{describe(interrupt)}: the results in {folder} were complete before the interrupt" if published(folder)
+                else f"{line} to {folder}")
+    sys.stderr.write(line + "\n")
+    return exit_code(interrupt)
+
+
 def main(argv: list[str] | None = None) -> int:
-    parser = build_parser()
-    args = parser.parse_args(argv)
+    from uamopt.interrupts import install_handlers, interrupt_of
+
+    install_handlers()  # SIGTERM cleans up like Ctrl-C (uamopt.interrupts)
+    try:
+        args = build_parser().parse_args(argv)
+    except KeyboardInterrupt as exc:
+        return _interrupted(None, exc)
     try:
         return args.func(args)
     except UamoptError as exc:
         sys.stderr.write(f"error: {exc.line()}\n")
         return EXIT_BAD_INPUT
-    except KeyboardInterrupt:
-        sys.stderr.write("error: interrupted (keyboard): nothing was written to --out\n")
-        return 130
+    except Exception as exc:
+        interrupt = interrupt_of(exc)  # a library that wrapped the KeyboardInterrupt in its own error
+        if interrupt is None:
+            raise
+        return _interrupted(args, interrupt)
+    except KeyboardInterrupt as exc:
+        return _interrupted(args, exc)

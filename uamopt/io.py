@@ -34,7 +34,7 @@ def _file(path: str | Path, name: str) -> Path:
 
 def _json(path: Path) -> dict:
     try:
-        doc = json.loads(path.read_text(encoding="utf-8"))
+        doc = json.loads(path.read_text(encoding="utf-8-sig"))
     except (ValueError, UnicodeDecodeError, RecursionError) as exc:
         raise InputFileError(f"malformed JSON: {exc}", str(path), "regenerate the folder with uamopt") from None
     except OSError as exc:

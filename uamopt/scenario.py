@@ -323,7 +323,8 @@ class ScheduleConfig(_Section):
 class Scenario(_Section):
     """A whole scenario: one TOML file, sections as in docs/interfaces.md."""
 
-    name: str = "scenario"
+    name: Annotated[str, Field(max_length=200)] = Field(
+        "scenario", description="the scenario's name, a figure title (at most 200 characters)")
     description: str = ""
     grid: GridConfig = GridConfig()
     city: CityConfig = CityConfig()
@@ -422,6 +423,11 @@ def _section_keys(loc: tuple) -> list[str]:
     return sorted(model.model_fields)
 
 
+def _brief(text: str, limit: int = 80) -> str:
+    """``text``, cut to ``limit`` characters for an error line."""
+    return text if len(text) <= limit else f"{text[:limit - 1]}… ({len(text):,} characters)"
+
+
 def _validate(raw: dict, source: str, base_dir: Path, overrides: list[str]) -> Scenario:
     try:
         scenario = Scenario.model_validate(raw)
@@ -432,14 +438,14 @@ def _validate(raw: dict, source: str, base_dir: Path, overrides: list[str]) -> S
         where = source
         for item in overrides:
             if item.partition("=")[0].strip() and key.startswith(item.partition("=")[0].strip()):
-                where = f"--set {item}"
+                where = f"--set {_brief(item)}"
         if err["type"] == "extra_forbidden":
             valid = _section_keys(loc)
             section = ".".join(str(p) for p in loc[:-1]) or "top level"
             fix = f"valid keys in [{section}] are {', '.join(valid)}" if valid else "remove it"
             raise ScenarioError(f"unknown key '{key}'", where, fix) from None
         value = err.get("input")
-        shown = f" {value!r}" if not isinstance(value, (dict, list, tuple)) or len(repr(value)) < 60 else ""
+        shown = f" {_brief(repr(value))}" if not isinstance(value, (dict, list, tuple)) or len(repr(value)) < 60 else ""
         msg = err["msg"].replace("Value error, ", "")
         info = _field_info(loc)
         fix = f"'{key}' is {info.description}" if info is not None and info.description else "see uamopt/scenario.py"

@@ -158,22 +158,21 @@ def schedule_folder(scenario: Scenario, out: str | Path, profile, flights_file=N
     """``uamopt schedule``: solve and write flights.json, schedule.csv, summary.json; returns
     (problem, schedule, violations found by the independent verifier in the written folder)."""
     from uamopt.export.frame import schedule_provenance
-    from uamopt.outputs import check_out_dir
+    from uamopt.outputs import output_lock
     from uamopt.pipeline import build_problem, scenario_grid, solve
     from uamopt.schedule import write_schedule
     from uamopt.schedule.verify import verify_dir
     from uamopt.solvers import load_profile
 
     profile = load_profile(profile) if isinstance(profile, (str, Path)) else profile
-    check_out_dir(out)
-    with progress(3, "schedule") as bar:
+    with output_lock(out), progress(3, "schedule") as bar:  # locked until verified: no other run's files
         flights = scenario_flights(scenario, flights_file, network_file, seed)
         bar.update(1)
         problem = build_problem(flights, scenario)
         bar.update(1)
         schedule = solve(problem, profile)
         bar.update(1)
-    extent = {"extent_m": list(scenario_grid(scenario).extent)}  # the airspace the verifier holds tracks to
-    write_schedule(out, problem, schedule, extra=schedule_provenance(scenario, list(overrides or [])) | extent)
-    return problem, schedule, verify_dir(out)
+        extent = {"extent_m": list(scenario_grid(scenario).extent)}  # the airspace the verifier holds tracks to
+        write_schedule(out, problem, schedule, extra=schedule_provenance(scenario, list(overrides or [])) | extent)
+        return problem, schedule, verify_dir(out)
 

@@ -173,7 +173,7 @@ def benchmark(problem_or_scenarios, solvers, seeds=None, time_limit_s: float | N
 def cmd_bench(args) -> int:
     """``uamopt bench``: the instances of the scenarios (or --flights), every profile × seed."""
     from uamopt.experiments.bench_report import write_bench
-    from uamopt.outputs import check_out_dir
+    from uamopt.outputs import output_lock
     from uamopt.scenario import load_scenario
 
     seeds = None
@@ -184,13 +184,13 @@ def cmd_bench(args) -> int:
                               "give a count (--seeds 3 runs seeds 0, 1, 2) or two or more seeds (--seeds 0 1 2)")
     profiles = _profiles(args.solver, args.time_limit)
     scenarios = [load_scenario(path, args.set) for path in args.scenario]
-    check_out_dir(args.out)
-    instances = {}
-    for scenario in scenarios:
-        name = instance_name(scenario, args.set)
-        instances[name if name not in instances else f"{name}#{len(instances) + 1}"] = _cli_problem(scenario, args)
-    table = benchmark(instances, profiles, seeds=seeds)
-    text = write_bench(args.out, table)
+    with output_lock(args.out):  # held from the first instance to the written report
+        instances = {}
+        for scenario in scenarios:
+            name = instance_name(scenario, args.set)
+            instances[name if name not in instances else f"{name}#{len(instances) + 1}"] = _cli_problem(scenario, args)
+        table = benchmark(instances, profiles, seeds=seeds)
+        text = write_bench(args.out, table)
     print(text)
     return 0 if bool(table["verified"].fillna(False).all()) else 1
 

@@ -19,8 +19,10 @@ from __future__ import annotations
 import logging
 import os
 import shutil
+import signal
 import sys
 import tempfile
+import threading
 from pathlib import Path
 
 from uamopt.errors import UamoptError
@@ -38,12 +40,14 @@ from uamopt.experiments.store import (
 CONNECT_TIMEOUT_S = 3.0
 
 
-def connect(scheduler: str | None, workers: int | None, tasks: int):
-    """A Dask client: on the cluster at ``scheduler``, or on a new loopback LocalCluster.
+def connect(scheduler: str | None, workers: int | None, tasks: int, scratch: str | None = None):
+    """A Dask client: on the cluster at ``scheduler``, or on a new loopback LocalCluster whose
+    scratch space and TMPDIR are ``scratch`` (default: Dask's, ``dask-scratch-space`` in TMPDIR).
 
     Returns (client, cluster or None). Raises UamoptError when the scheduler cannot be reached
     within CONNECT_TIMEOUT_S.
     """
+    import dask
     from distributed import Client, LocalCluster
 
     if scheduler:
@@ -55,8 +59,20 @@ def connect(scheduler: str | None, workers: int | None, tasks: int):
             raise UamoptError(f"cannot reach the Dask scheduler at {scheduler} ({error_line(exc)})", "--scheduler",
                               "start one with `dask scheduler`, check the address, or drop --scheduler") from None
     n = workers or max(1, min(os.cpu_count() or 1, tasks))
-    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, host="127.0.0.1",
-                           dashboard_address="127.0.0.1:0", silence_logs=logging.ERROR)  # a free loopback port
+    # Ctrl-C reaches every process of the terminal's group, and the workers printed tracebacks.
+    # Processes started while SIGINT is ignored keep ignoring it, so the workers start so; this
+    # process takes Ctrl-C again once they run, and stops them (a Ctrl-C during the start is lost).
+    main = threading.current_thread() is threading.main_thread()
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN) if main else None
+    try:
+        # every temporary file of the cluster in ``scratch``, removed afterwards even where a worker
+        # was stopped mid-task; worker logs muted (a task's error is in its row)
+        with dask.config.set({"temporary-directory": scratch}):
+            cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, host="127.0.0.1",
+                                   dashboard_address="127.0.0.1:0", silence_logs=logging.CRITICAL, env={"TMPDIR": scratch})
+    finally:
+        if main:
+            signal.signal(signal.SIGINT, signal.SIG_DFL if previous is None else previous)
     return Client(cluster), cluster
 
 
@@ -176,14 +192,17 @@ def sweep(path, out=None, scheduler: str | None = None, workers: int | None = No
     if workers is not None and scheduler:
         raise UamoptError("--workers applies to the local cluster, not to --scheduler", "--workers",
                           "drop --workers (the cluster's workers are started with `dask worker`)")
+    from uamopt.outputs import output_lock
+
     spec = load_sweep(path, small=small)
-    temporary = out is None
-    folder = ResultsFolder(tempfile.mkdtemp(prefix="uamopt-sweep-") if temporary else out)
+    if out is not None:
+        with output_lock(out):  # one sweep at a time into a results folder
+            return _sweep(spec, ResultsFolder(out), scheduler, workers)
+    folder = ResultsFolder(tempfile.mkdtemp(prefix="uamopt-sweep-"))
     try:
         return _sweep(spec, folder, scheduler, workers)
     finally:
-        if temporary:
-            shutil.rmtree(folder.out, ignore_errors=True)
+        shutil.rmtree(folder.out, ignore_errors=True)
 
 
 def _sweep(spec: SweepSpec, folder: ResultsFolder, scheduler, workers):
@@ -191,15 +210,19 @@ def _sweep(spec: SweepSpec, folder: ResultsFolder, scheduler, workers):
     todo, have = _todo(spec, done)
     unsaved, stats = [], {"cases": len(spec.cases), "run": len(todo), "errors": 0}
     if todo:
-        client, cluster = connect(scheduler, workers, len(todo))
+        scratch = tempfile.mkdtemp(prefix="uamopt-dask-")  # the workers' scratch space, removed afterwards
         try:
-            folder.start(spec)
-            with Progress(len(todo), f"sweep {spec.name}", "cases") as progress:
-                unsaved, stats["errors"] = _run(spec, folder, todo, have, client, progress)
+            client, cluster = connect(scheduler, workers, len(todo), scratch)
+            try:
+                folder.start(spec)
+                with Progress(len(todo), f"sweep {spec.name}", "cases") as progress:
+                    unsaved, stats["errors"] = _run(spec, folder, todo, have, client, progress)
+            finally:
+                client.close()
+                if cluster is not None:
+                    cluster.close()
         finally:
-            client.close()
-            if cluster is not None:
-                cluster.close()
+            shutil.rmtree(scratch, ignore_errors=True)
     else:
         folder.start(spec)
     table = results_table(spec, [folder.check(spec)] + unsaved)
@@ -214,12 +237,16 @@ def _sweep(spec: SweepSpec, folder: ResultsFolder, scheduler, workers):
 
 def cmd_sweep(args) -> int:
     """``uamopt sweep``: run, then one summary line on stdout."""
-    out = Path(args.out) if args.out else Path("out") / "sweeps" / (Path(args.sweep).stem + ("-small" if args.small else ""))
+    from uamopt.interrupts import describe, exit_code
+    from uamopt.outputs import check_out_dir
+
+    default = Path("out") / "sweeps" / (Path(args.sweep).stem + ("-small" if args.small else ""))
+    out = default if args.out is None else check_out_dir(args.out)
     try:
         table = sweep(args.sweep, out=out, scheduler=args.scheduler, workers=args.workers, small=args.small)
-    except KeyboardInterrupt:
-        sys.stderr.write(f"error: interrupted (keyboard): finished cases are saved in {out}: re-run the same command to finish\n")
-        return 130
+    except KeyboardInterrupt as exc:
+        sys.stderr.write(f"{describe(exc)}: finished cases are saved in {out}: re-run the same command to finish\n")
+        return exit_code(exc)
     a = table.attrs
     errors = int((table["status"] == "error").sum())
     print(f"sweep {out}: {len(table)} rows ({errors} with errors), {a['run']} of {a['cases']} cases run now, "

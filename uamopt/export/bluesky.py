@@ -40,8 +40,8 @@ from pathlib import Path
 import numpy as np
 
 from uamopt.errors import UamoptError
-from uamopt.export.folder import ScheduleFolder, read_schedule_folder, write_text_atomic
 from uamopt.export.defaults import DEFAULT_BANK_DEG, DEFAULT_DT_S, DEFAULT_TRAJECTORY, TRAJECTORIES
+from uamopt.export.folder import ScheduleFolder, read_schedule_folder, write_texts
 from uamopt.export.trajectory import (
     ACCEL_SHARE,
     DESIGN_STEP_S,
@@ -216,6 +216,5 @@ def export_bluesky(path: str | Path, zone_m: tuple[float, float] | None = None, 
     if zone_m is None:
         zone = protected_zone(folder.flights.cell, folder.flights.conflict_radius)
         zone_m = (zone.rpz_m, zone.hpz_m)
-    target = folder.path / "bluesky.scn"
-    write_text_atomic(target, scenario_text(folder, zone_m, dt_s=dt_s, bank_deg=bank_deg, trajectory=trajectory))
-    return target
+    text = scenario_text(folder, zone_m, dt_s=dt_s, bank_deg=bank_deg, trajectory=trajectory)
+    return write_texts(folder.path, {"bluesky.scn": text})[0]

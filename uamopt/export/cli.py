@@ -62,31 +62,37 @@ def _zone(args, folder_path: str):
 
 def cmd_export_bluesky(args) -> int:
     from uamopt.export.bluesky import export_bluesky
+    from uamopt.outputs import output_lock
 
-    _, zone = _zone(args, args.dir)
-    path = export_bluesky(args.dir, (zone.rpz_m, zone.hpz_m), dt_s=args.dt, bank_deg=args.bank,
-                          trajectory=args.trajectory)
+    with output_lock(args.dir, "DIR"):
+        _, zone = _zone(args, args.dir)
+        path = export_bluesky(args.dir, (zone.rpz_m, zone.hpz_m), dt_s=args.dt, bank_deg=args.bank,
+                              trajectory=args.trajectory)
     print(f"BlueSky scenario (protected zone r_pz = {zone.rpz_m:g} m, h_pz = {zone.hpz_m:g} m) -> {path}")
     return 0
 
 
 def cmd_export_geojson(args) -> int:
     from uamopt.export.geojson import export_geojson
+    from uamopt.outputs import output_lock
 
     if args.risk and args.scenario:
         raise UamoptError("--risk and --scenario both given", "command line", "give one source of the unsafe airspace")
-    paths = export_geojson(args.dir, risk=args.risk, scenario=args.scenario, overrides=args.set)
+    with output_lock(args.dir, "DIR"):
+        paths = export_geojson(args.dir, risk=args.risk, scenario=args.scenario, overrides=args.set)
     print("GeoJSON (WGS 84): " + ", ".join(p.name for p in paths) + f" -> {Path(args.dir)}")
     return 0
 
 
 def cmd_replay(args) -> int:
+    from uamopt.outputs import output_lock
     from uamopt.sim.replay import replay
 
-    budget, zone = _zone(args, args.dir)
-    window = _pair(args.window, "--window", "0,900")
-    result = replay(args.dir, dt_s=args.dt, bank_deg=args.bank, budget_h_m=budget[0], budget_v_m=budget[1],
-                    zone_m=(zone.rpz_m, zone.hpz_m), window_s=window, trajectory=args.trajectory)
+    with output_lock(args.dir, "DIR"):  # held while BlueSky reads the folder, until the results are in
+        budget, zone = _zone(args, args.dir)
+        window = _pair(args.window, "--window", "0,900")
+        result = replay(args.dir, dt_s=args.dt, bank_deg=args.bank, budget_h_m=budget[0], budget_v_m=budget[1],
+                        zone_m=(zone.rpz_m, zone.hpz_m), window_s=window, trajectory=args.trajectory)
     d = result.as_dict()["deviation"]
     print(f"BlueSky replay: {len(result.flights)} flights, {result.los_count} losses of separation "
           f"(r_pz = {zone.rpz_m:g} m, h_pz = {zone.hpz_m:g} m), {len(result.near_pairs)} near pairs; deviation from the "

@@ -10,8 +10,6 @@ from __future__ import annotations
 import csv
 import json
 import math
-import os
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -62,7 +60,7 @@ def _operated(path: Path, flights: FlightSet) -> tuple[OperatedFlight, ...]:
         raise InputFileError(f"missing {path.name}", str(path.parent), "give a folder written by uamopt schedule")
     by_id = {f.id: f for f in flights.flights}
     out = []
-    with open(path, newline="", encoding="utf-8") as fh:
+    with open(path, newline="", encoding="utf-8-sig") as fh:  # -sig: a spreadsheet's BOM is not a column name
         reader = csv.DictReader(fh)
         need = ("flight", "operated", "departure_s", "arrival_s")
         if reader.fieldnames is None or any(c not in reader.fieldnames for c in need):
@@ -95,7 +93,7 @@ def read_schedule_folder(path: str | Path) -> ScheduleFolder:
     summary_path = folder / "summary.json"
     if summary_path.is_file():
         try:
-            summary = json.loads(summary_path.read_text(encoding="utf-8"))
+            summary = json.loads(summary_path.read_text(encoding="utf-8-sig"))
         except (json.JSONDecodeError, UnicodeDecodeError, RecursionError) as exc:
             raise InputFileError(f"malformed JSON: {exc}", str(summary_path), "rewrite it with uamopt schedule") from None
         if not isinstance(summary, dict):
@@ -129,17 +127,12 @@ def recorded_scenario(folder: ScheduleFolder, scenario_path: str | None = None, 
     return load_scenario(record["file"], list(record.get("set", [])) + list(overrides or []))
 
 
-def write_text_atomic(path: Path, text: str) -> None:
-    """Write ``text`` to ``path`` through a temporary file and a rename: never half-written."""
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as fh:
-            fh.write(text)
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)  # as an ordinary open() would create it
-        os.replace(tmp, path)
-    except OSError as exc:
-        Path(tmp).unlink(missing_ok=True)
-        raise InputFileError(f"cannot write {path.name}: {exc.strerror or exc}", str(path.parent),
-                             "check the folder's permissions") from None
+def write_texts(folder: Path, texts: dict[str, str]) -> list[Path]:
+    """Write ``texts`` (file name -> text) into the existing folder ``folder``, all or nothing,
+    under its lock (uamopt.outputs.staged_output); returns the paths written."""
+    from uamopt.outputs import staged_output
+
+    with staged_output(folder, "DIR") as stage:
+        for name, text in texts.items():
+            (stage / name).write_text(text, encoding="utf-8")
+    return [folder / name for name in texts]

@@ -33,7 +33,7 @@ from uamopt.export.folder import (
     ScheduleFolder,
     read_schedule_folder,
     recorded_scenario,
-    write_text_atomic,
+    write_texts,
 )
 
 DEGREE_DIGITS = 7  # ~1 cm
@@ -146,8 +146,5 @@ def export_geojson(path: str | Path, *, risk: str | Path | None = None, scenario
     layers = _unsafe_layers(folder, risk, scenario, overrides)  # before writing anything
     files = {"tracks.geojson": track_features(folder), "vertiports.geojson": vertiport_features(folder),
              "unsafe.geojson": unsafe_features(folder, *layers)}
-    written = []
-    for name, features in files.items():
-        write_text_atomic(folder.path / name, _collection(features, folder, name.removesuffix(".geojson")))
-        written.append(folder.path / name)
-    return written
+    return write_texts(folder.path, {name: _collection(features, folder, name.removesuffix(".geojson"))
+                                     for name, features in files.items()})

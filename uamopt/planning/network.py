@@ -208,7 +208,7 @@ def load_network(path: str | Path) -> RouteNetwork:
     if path.is_dir():
         path = path / "network.json"
     try:
-        doc = json.loads(path.read_text(encoding="utf-8"))
+        doc = json.loads(path.read_text(encoding="utf-8-sig"))
         return RouteNetwork.from_document(doc)
     except FileNotFoundError:
         raise InputFileError(f"network file not found: {path}", "network.json", "run `uamopt network` first") from None

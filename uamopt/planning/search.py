@@ -107,7 +107,17 @@ def transport_lower_bound(a: tuple[int, int, int], b: tuple[int, int, int], cell
 # --- fast backend: numba ----------------------------------------------------------------------
 
 
-@njit(cache=True)
+def _compiled(func):
+    """``func`` compiled by numba and cached on disk; where no cache folder is writable (a
+    read-only install without a writable NUMBA_CACHE_DIR or home), numba refuses ``cache=True``
+    with a RuntimeError, and the function is compiled afresh in each process instead."""
+    try:
+        return njit(cache=True)(func)
+    except RuntimeError:
+        return njit(func)
+
+
+@_compiled
 def _heap_push(keys, nodes, size, key, node):
     if size == keys.shape[0]:
         new_keys = np.empty(2 * size, dtype=keys.dtype)
@@ -129,7 +139,7 @@ def _heap_push(keys, nodes, size, key, node):
     return keys, nodes, size + 1
 
 
-@njit(cache=True)
+@_compiled
 def _heap_pop(keys, nodes, size):
     key, node = keys[0], nodes[0]
     size -= 1
@@ -152,7 +162,7 @@ def _heap_pop(keys, nodes, size):
     return key, node, size
 
 
-@njit(cache=True)
+@_compiled
 def _astar_numba(passable, risk, penalty, priority, nx, ny, nz, dx, dy, dz, w_risk, c_h, c_v,
                  start, goal, use_heuristic, offsets, corners, counts, lengths, transports):
     n_cells = nx * ny * nz

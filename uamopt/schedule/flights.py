@@ -377,7 +377,7 @@ def load_flights(
     if not path.is_file():
         raise InputFileError(f"flights file not found: {path}", source, "give the path of a flights.json")
     try:
-        raw = json.loads(path.read_text(encoding="utf-8"))
+        raw = json.loads(path.read_text(encoding="utf-8-sig"))
     except json.JSONDecodeError as exc:
         raise InputFileError(f"malformed JSON: {exc.msg} at line {exc.lineno} column {exc.colno}", source, "fix the syntax") from None
     except UnicodeDecodeError:

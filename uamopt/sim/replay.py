@@ -40,7 +40,7 @@ from uamopt.export.bluesky import (
     flight_trajectories,
     scenario_text,
 )
-from uamopt.export.folder import ScheduleFolder, read_schedule_folder, write_text_atomic
+from uamopt.export.folder import ScheduleFolder, read_schedule_folder
 from uamopt.sim.analysis import flight_deviation, pair_separations
 from uamopt.sim.zone import (
     DEFAULT_BUDGET_H_M,
@@ -191,11 +191,13 @@ def replay(path: str | Path, *, dt_s: float = DEFAULT_DT_S, bank_deg: float = DE
                "bluesky_cpu": meta["process_cpu_s"], "total": time.perf_counter() - started}
     result = ReplayResult(folder.path, zone, result[0], result[1], result[2], settings, seconds)
     if write:
+        from uamopt.outputs import staged_output
         from uamopt.sim.plot import plot_replay
 
-        plot_replay(result, folder.path / "replay.png")
-        write_text_atomic(folder.path / "bluesky.scn", text)
-        write_text_atomic(folder.path / "replay.json", json.dumps(result.as_dict(), indent=2) + "\n")
+        with staged_output(folder.path, "DIR") as stage:  # all three or none (uamopt.outputs)
+            plot_replay(result, stage / "replay.png")
+            (stage / "bluesky.scn").write_text(text, encoding="utf-8")
+            (stage / "replay.json").write_text(json.dumps(result.as_dict(), indent=2) + "\n", encoding="utf-8")
     return result
 
 

@@ -42,6 +42,7 @@ import math
 import numpy as np
 
 from uamopt.errors import UamoptError
+from uamopt.interrupts import stopping
 from uamopt.schedule.flights import TIME_TOL_S
 from uamopt.schedule.model import Schedule, SchedulingProblem, make_schedule
 
@@ -150,6 +151,7 @@ def _solver(profile, options: dict, limit_s: float):
         except (AttributeError, TypeError, ValueError) as exc:
             raise UamoptError(f"unknown or invalid CP-SAT option '{key}': {exc}", f"profile {profile.name or 'cpsat'}",
                               "see ortools/sat/sat_parameters.proto") from None
+    solver.parameters.catch_sigint_signal = False  # its own Ctrl-C handler swallows the interrupt (uamopt.interrupts)
     return solver
 
 
@@ -182,7 +184,8 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
         model.add_hint(delay[f], int(np.rint(start.delay_s[f] / unit_s)) if start.operated[f] else 0)
     build_s = time.perf_counter() - t0  # model, warm start and hints
     solver = _solver(profile, options, max(0.05, profile.time_limit_s - build_s))  # the limit covers the build too
-    code = solver.solve(model)
+    with stopping(solver.stop_search):  # Ctrl-C and SIGTERM stop the search at once
+        code = solver.solve(model)
     seconds = time.perf_counter() - t0
     n = problem.n_flights
     extras = {"termination": solver.status_name(code), "time_unit_s": unit_s, "objective_scale": how,
@@ -213,7 +216,8 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
             inner.add_hint(i_delay[f], int(delay_k[f]))
         left = max(0.05, profile.time_limit_s - (time.perf_counter() - t0))
         relaxed = _solver(profile, options, left)
-        r_code = relaxed.solve(inner)
+        with stopping(relaxed.stop_search):
+            r_code = relaxed.solve(inner)
         if r_code in (cp_model.OPTIMAL, cp_model.FEASIBLE, cp_model.UNKNOWN):
             low = objective_bound(problem, relaxed.best_objective_bound, i_flight, i_div, unit_s, i_how)
             schedule.extras.update(continuous_bound=low, continuous_bound_termination=relaxed.status_name(r_code),

@@ -37,6 +37,7 @@ what is left) and HiGHS, which gets the rest.
 
 from __future__ import annotations
 
+import logging
 import time
 
 import numpy as np
@@ -45,6 +46,7 @@ from pyomo.contrib.solver.common.factory import SolverFactory
 from pyomo.contrib.solver.common.results import SolutionStatus, TerminationCondition
 
 from uamopt.errors import UamoptError
+from uamopt.interrupts import stopping
 from uamopt.schedule.flights import TIME_TOL_S
 from uamopt.schedule.model import Schedule, SchedulingProblem, make_schedule
 from uamopt.solvers.deadline import interrupt_at
@@ -231,14 +233,16 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
     left = profile.time_limit_s - (time.perf_counter() - t0)
     if left <= 0.05:
         return _start_only(problem, profile, start, t0, f"the time limit ran out while building the MILP ({build_s:.1f} s)")
-    result = solver.solve(m, time_limit=left, threads=int(profile.threads), solver_options=options,
-                          load_solutions=False, raise_exception_on_nonoptimal_result=False)
+    with stopping(cancel(solver)):  # Ctrl-C and SIGTERM stop HiGHS at once
+        result = solver.solve(m, time_limit=left, threads=int(profile.threads), solver_options=options,
+                              load_solutions=False, raise_exception_on_nonoptimal_result=False)
     if _stale_solution(m, result):  # highspy 1.16: the start's values beside a better objective; solve cold
         m = build_model(reduced(problem))
         left = max(0.05, profile.time_limit_s - (time.perf_counter() - t0))
-        result = SolverFactory(SOLVER_NAME).solve(m, time_limit=left, threads=int(profile.threads),
-                                                  solver_options=options, load_solutions=False,
-                                                  raise_exception_on_nonoptimal_result=False)
+        solver = SolverFactory(SOLVER_NAME)
+        with stopping(cancel(solver)):
+            result = solver.solve(m, time_limit=left, threads=int(profile.threads), solver_options=options,
+                                  load_solutions=False, raise_exception_on_nonoptimal_result=False)
     tc, has_solution = result.termination_condition, result.solution_status in (SolutionStatus.optimal, SolutionStatus.feasible)
     extras = {"termination": tc.name, "nodes": getattr(result.extra_info, "mip_node_count", None),
               "highs_objective": result.incumbent_objective, "highs_seconds": result.timing_info.highs_time,
@@ -290,6 +294,16 @@ def _start_only(problem: SchedulingProblem, profile, start, t0: float, why: str)
     return make_schedule(problem, "highs", "time_limit", start.operated, start.delay_s, solve_seconds=time.perf_counter() - t0,
                          seed=profile.seed, extras={"termination": "not run", "incumbent": why, "model": MODEL,
                                                     "warm_start": f"{start.source} {start.objective:.6f}"})
+
+
+def cancel(solver):
+    """What stops Pyomo's HiGHS ``solver`` mid-solve (uamopt.interrupts.stopping): its highspy model,
+    which exists once the solve has begun. Pyomo's warning about the interrupted status is muted."""
+    def stop() -> None:
+        logging.getLogger(type(solver).__module__).setLevel(logging.ERROR)
+        solver._solver_model.cancelSolve()
+
+    return stop
 
 
 def _stale_solution(m: pyo.ConcreteModel, result) -> bool:

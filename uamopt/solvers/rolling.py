@@ -63,6 +63,7 @@ import time
 import numpy as np
 
 from uamopt.errors import UamoptError
+from uamopt.interrupts import stopping
 from uamopt.schedule.flights import TIME_TOL_S
 from uamopt.schedule.model import Schedule, SchedulingProblem, make_schedule, violations
 from uamopt.schedule.occupancy import ConflictTable
@@ -166,11 +167,13 @@ def _inner_cpsat(sub: SchedulingProblem, hint: tuple[np.ndarray, np.ndarray], li
     solver.parameters.max_time_in_seconds = float(limit_s)
     solver.parameters.num_workers = int(threads)
     solver.parameters.random_seed = int(seed)
+    solver.parameters.catch_sigint_signal = False  # its own Ctrl-C handler swallows the interrupt (uamopt.interrupts)
     if threads == 1:
         solver.parameters.linearization_level = 2
     else:
         solver.parameters.subsolvers.extend(["max_lp", "default_lp"])
-    code = solver.solve(model)
+    with stopping(solver.stop_search):
+        code = solver.solve(model)
     if code not in (cp_model.OPTIMAL, cp_model.FEASIBLE):
         return None
     operated = np.array([solver.boolean_value(v) for v in operate])
@@ -187,9 +190,11 @@ def _inner_highs(sub: SchedulingProblem, limit_s: float, threads: int, seed: int
     from uamopt.solvers import milp
 
     m = milp.build_model(sub)  # the fixed flights must operate (sub.must_operate)
-    result = SolverFactory(milp.SOLVER_NAME).solve(
-        m, time_limit=float(limit_s), threads=int(threads), solver_options={"mip_rel_gap": 0.0, "random_seed": int(seed)},
-        load_solutions=False, raise_exception_on_nonoptimal_result=False)
+    solver = SolverFactory(milp.SOLVER_NAME)
+    with stopping(milp.cancel(solver)):
+        result = solver.solve(m, time_limit=float(limit_s), threads=int(threads),
+                              solver_options={"mip_rel_gap": 0.0, "random_seed": int(seed)}, load_solutions=False,
+                              raise_exception_on_nonoptimal_result=False)
     if result.solution_status not in (SolutionStatus.optimal, SolutionStatus.feasible):
         return None
     result.solution_loader.load_vars()

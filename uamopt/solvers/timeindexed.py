@@ -66,6 +66,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from uamopt.errors import UamoptError
+from uamopt.interrupts import stopping
 from uamopt.schedule.flights import TIME_TOL_S
 from uamopt.schedule.model import Schedule, SchedulingProblem, make_schedule
 from uamopt.solvers.deadline import highs_can_start, interrupt_at, quiet_highs
@@ -265,7 +266,9 @@ def _highs(model: GridModel, deadline: float, threads: int, seed: int, gap: floa
     t0 = time.perf_counter()
     found: list[float] = []  # times of HiGHS's improving solutions
     h.cbMipImprovingSolution.subscribe(lambda *_: found.append(time.perf_counter() - t0))
-    if h.run() == highspy.HighsStatus.kError:
+    with stopping(h.cancelSolve):  # Ctrl-C and SIGTERM stop HiGHS at once
+        run_status = h.run()
+    if run_status == highspy.HighsStatus.kError:
         raise UamoptError("HiGHS stopped with an error", "solver timeindexed", "rerun with output_flag = true to see why")
     seconds = time.perf_counter() - t0
     status = h.getModelStatus()
@@ -320,13 +323,15 @@ def _cpsat(model: GridModel, problem: SchedulingProblem, deadline: float, thread
     solver.parameters.num_workers = int(threads)
     solver.parameters.random_seed = int(seed)
     solver.parameters.relative_gap_limit = float(gap)
+    solver.parameters.catch_sigint_signal = False  # its own Ctrl-C handler swallows the interrupt (uamopt.interrupts)
     found: list[float] = []
 
     class _Times(cp_model.CpSolverSolutionCallback):
         def on_solution_callback(self) -> None:
             found.append(self.wall_time)
 
-    code = solver.solve(m, _Times())
+    with stopping(solver.stop_search):
+        code = solver.solve(m, _Times())
     has = code in (cp_model.OPTIMAL, cp_model.FEASIBLE)
     values = np.array([solver.boolean_value(v) for v in x], dtype=float) if has else None
     bound = objective_bound(problem, solver.best_objective_bound, per_flight, divisor, model.step_s, how)

@@ -1,0 +1,152 @@
+"""Ctrl-C and SIGTERM: a command stops cleanly, and the step that publishes results is never cut.
+
+Ctrl-C raises ``KeyboardInterrupt`` in Python; :func:`install_handlers` makes SIGTERM raise
+:class:`Terminated` (a ``KeyboardInterrupt``) the same way, so every ``finally`` clause runs: the
+staging folder is removed and the ``--out`` lock released (uamopt.outputs). Inside
+:func:`deferred_signals` both signals are held and delivered when the block ends, so a publish
+or a clean-up always completes. :func:`stopping` makes a running HiGHS or CP-SAT solve stop at
+once. The CLI turns either signal into one line and exit code 130 (SIGINT) or 143 (SIGTERM):
+docs/interfaces.md.
+
+Where interrupts got lost before: CP-SAT's own SIGINT handler (``catch_sigint_signal``, off in
+uamopt) ended the search, returned its incumbent as if the time limit had come, and left SIGINT
+at its default, so a later Ctrl-C killed the process without clean-up; a KeyboardInterrupt
+raised inside a C callback (numba's compiler calls Python back through ctypes) was printed as
+"Exception ignored" with a traceback and the command went on.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import sys
+import threading
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager, suppress
+
+EXIT_SIGINT = 130  # 128 + SIGINT, the shell's code for Ctrl-C
+EXIT_SIGTERM = 143  # 128 + SIGTERM
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM, raised like Ctrl-C so that clean-up code runs."""
+
+
+def _raise_terminated(signum, frame) -> None:
+    raise Terminated()
+
+
+def _unraisable_hook(default):
+    def hook(unraisable) -> None:
+        interrupt = unraisable.exc_value
+        if isinstance(interrupt, KeyboardInterrupt):
+            # Raised inside a C callback (numba's compiler calls back through ctypes), which can
+            # only print it and go on: signal the main thread again a moment later, from a timer,
+            # so that it surfaces in the command's own code (or here again, until it does).
+            signum = signal.SIGTERM if isinstance(interrupt, Terminated) else signal.SIGINT
+            timer = threading.Timer(0.05, signal.pthread_kill, args=(threading.main_thread().ident, signum))
+            timer.daemon = True
+            timer.start()
+            return
+        default(unraisable)
+
+    hook.uamopt = True
+    return hook
+
+
+def install_handlers() -> None:
+    """Make SIGTERM raise :class:`Terminated`, and an interrupt that a C callback swallowed come
+    back instead of printing a traceback (the CLI calls this once, in the main thread)."""
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGTERM, _raise_terminated)
+        if not getattr(sys.unraisablehook, "uamopt", False):
+            sys.unraisablehook = _unraisable_hook(sys.unraisablehook)
+
+
+def interrupt_of(exc: BaseException) -> KeyboardInterrupt | None:
+    """The interrupt behind ``exc``: itself, or one in its cause/context chain (a library may
+    wrap a KeyboardInterrupt raised inside its callback in an error of its own)."""
+    seen = set()
+    while exc is not None and id(exc) not in seen:
+        if isinstance(exc, KeyboardInterrupt):
+            return exc
+        seen.add(id(exc))
+        exc = exc.__cause__ or exc.__context__
+    return None
+
+
+def exit_code(interrupt: KeyboardInterrupt) -> int:
+    """130 for Ctrl-C, 143 for SIGTERM."""
+    return EXIT_SIGTERM if isinstance(interrupt, Terminated) else EXIT_SIGINT
+
+
+def describe(interrupt: KeyboardInterrupt) -> str:
+    """``"terminated"`` (SIGTERM) or ``"interrupted"`` (Ctrl-C)."""
+    return "terminated" if isinstance(interrupt, Terminated) else "interrupted"
+
+
+@contextmanager
+def deferred_signals() -> Iterator[None]:
+    """Hold SIGINT and SIGTERM for the block, then act on the first one that came.
+
+    Python runs signal handlers in the main thread only, so elsewhere this is a no-op (signals
+    cannot interrupt a non-main thread's code anyway).
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    pending: list[int] = []
+    held = (signal.SIGINT, signal.SIGTERM)
+    previous = {s: signal.signal(s, lambda signum, frame: pending.append(signum)) for s in held}
+    try:
+        yield
+    finally:
+        for s, handler in previous.items():
+            signal.signal(s, signal.SIG_DFL if handler is None else handler)
+        if pending:
+            handler = previous[pending[0]]
+            if callable(handler):
+                handler(pending[0], None)  # raises KeyboardInterrupt / Terminated, or an outer block holds it
+            elif handler in (signal.SIG_DFL, None):
+                os.kill(os.getpid(), pending[0])  # the default action: end the process
+
+
+@contextmanager
+def stopping(stop: Callable[[], object]) -> Iterator[None]:
+    """Let Ctrl-C and SIGTERM stop a solver that runs in C++ inside the block.
+
+    Python runs signal handlers between the main thread's bytecodes, so during a long C++ call
+    (HiGHS, CP-SAT) an interrupt would wait for the solver's time limit, and a library that saw
+    it might turn it into an error or a result of its own. Inside the block both signals are
+    held (:func:`deferred_signals`); a watcher thread, woken through :func:`signal.set_wakeup_fd`,
+    calls ``stop`` (``CpSolver.stop_search``, ``Highs.cancelSolve``) until the block ends, and the
+    block's end raises the interrupt. Outside the main thread this is a no-op.
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    read_fd, write_fd = os.pipe()
+    os.set_blocking(write_fd, False)
+    ended = threading.Event()
+
+    def watch() -> None:
+        while data := os.read(read_fd, 1):  # b"" once the block ends and closes the pipe
+            if data[0] in (signal.SIGINT, signal.SIGTERM):
+                while not ended.is_set():  # again and again: the solver may not have started yet
+                    with suppress(Exception):
+                        stop()
+                    ended.wait(0.1)
+                return
+
+    previous = signal.set_wakeup_fd(write_fd, warn_on_full_buffer=False)
+    watcher = threading.Thread(target=watch, name="uamopt-interrupt-watcher", daemon=True)
+    watcher.start()
+    try:
+        with deferred_signals():
+            yield
+    finally:
+        ended.set()
+        signal.set_wakeup_fd(previous)
+        os.close(write_fd)
+        watcher.join()
+        os.close(read_fd)
