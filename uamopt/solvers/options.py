@@ -82,7 +82,7 @@ PASS_THROUGH = {"highs": "HiGHS", "cpsat": "CP-SAT"}
 #: library options the profile's own fields set (an option would silently fight the field)
 RESERVED = {"highs": {"time_limit": "time_limit_s", "threads": "threads", "random_seed": "seed"},
             "cpsat": {"max_time_in_seconds": "time_limit_s", "num_workers": "threads", "num_search_workers": "threads",
-                      "random_seed": "seed"}}
+                      "random_seed": "seed", "catch_sigint_signal": "Ctrl-C handling (uamopt.interrupts)"}}
 
 
 def refuse_unknown(options: dict, known: set[str], solver: str) -> None:
@@ -178,6 +178,7 @@ def _check_cpsat(options: dict, where: str) -> None:
     model.add_bool_or([model.new_bool_var("x")])
     params.max_time_in_seconds = 1.0
     params.num_workers = 1
+    params.catch_sigint_signal = False  # CP-SAT's own Ctrl-C handler would replace ours (uamopt.interrupts)
     if solver.solve(model) == cp_model.MODEL_INVALID:
         raise UamoptError(f"CP-SAT refuses the options: {solver.solution_info()}", where,
                           "see ortools/sat/sat_parameters.proto")
