@@ -237,7 +237,7 @@ def _sweep(spec: SweepSpec, folder: ResultsFolder, scheduler, workers):
 
 def cmd_sweep(args) -> int:
     """``uamopt sweep``: run, then one summary line on stdout."""
-    from uamopt.interrupts import describe, exit_code
+    from uamopt.interrupts import describe, handled
     from uamopt.outputs import check_out_dir
 
     default = Path("out") / "sweeps" / (Path(args.sweep).stem + ("-small" if args.small else ""))
@@ -246,7 +246,7 @@ def cmd_sweep(args) -> int:
         table = sweep(args.sweep, out=out, scheduler=args.scheduler, workers=args.workers, small=args.small)
     except KeyboardInterrupt as exc:
         sys.stderr.write(f"{describe(exc)}: finished cases are saved in {out}: re-run the same command to finish\n")
-        return exit_code(exc)
+        return handled(exc)
     a = table.attrs
     errors = int((table["status"] == "error").sum())
     print(f"sweep {out}: {len(table)} rows ({errors} with errors), {a['run']} of {a['cases']} cases run now, "
