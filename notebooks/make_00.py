@@ -1,10 +1,6 @@
 """Write notebooks/00_quickstart.ipynb: the paper case end to end with `import uamopt` only."""
-from pathlib import Path
+from nbgen import code, md, write_notebook
 
-import nbformat
-from nbformat.v4 import new_code_cell, new_markdown_cell, new_notebook
-
-md, code = new_markdown_cell, new_code_cell
 cells = [
     md("""# 00 · Quick start: the paper case end to end (`import uamopt` only)
 
@@ -51,11 +47,4 @@ assert len(table) == 4 and table["verified"].all()
 table[["profile", "seed", "status", "objective", "operated", "solve_seconds"]]"""),
 ]
 
-nb = new_notebook(cells=cells, metadata={
-    "kernelspec": {"display_name": "Python 3 (ipykernel)", "language": "python", "name": "python3"},
-    "language_info": {"name": "python"},
-})
-nbformat.validate(nb)
-target = Path(__file__).resolve().parent / "00_quickstart.ipynb"
-nbformat.write(nb, target)
-print("wrote", target)
+write_notebook(cells, "00_quickstart.ipynb")

@@ -69,11 +69,24 @@ def test_solve_and_verify(stages):
     assert "conflict" in set(check.violations["kind"])
 
 
+def test_weight_sweep_is_public(stages):
+    """ua.weight_sweep (Fig. 21): its two extremes are the lexicographic optima, so no other
+    weighting finds a cheaper or a less risky track; every point feeds ua.plotting.pareto."""
+    _, _, model, plan, *_ = stages
+    points = ua.weight_sweep(model, "V1", "V4", 4)
+    cheap, safe = points[0], points[1]  # (ε, 1) and (1, ε) are solved first
+    assert len(points) >= 3 and cheap.w5 == safe.w4 == 1.0
+    assert all(cheap.transport_cost <= p.transport_cost + 1e-9 and safe.risk_cost <= p.risk_cost + 1e-9 for p in points)
+    assert safe.risk_cost < cheap.risk_cost  # risk can be bought down on this route
+    fig = ua.plotting.pareto(points, plan=plan)
+    assert len(fig.axes) == 1
+
+
 def test_solver_profile_overrides():
     profile = ua.solver_profile("soa", time_limit_s=5.0, seed=3, options={"generations": 7})
     assert (profile.time_limit_s, profile.seed, profile.options["generations"], profile.options["population"]) == \
         (5.0, 3, 7, 50)
-    with pytest.raises(ua.UamoptError, match="time_limit_s must be positive"):
+    with pytest.raises(ua.UamoptError, match="time_limit_s must be a positive number of seconds, got 0.0"):
         ua.solver_profile("greedy", time_limit_s=0.0)
 
 

@@ -12,12 +12,14 @@ from oracles import objective_from_folder
 from test_cli import assert_one_line_error, cli
 
 PAPER = str(PAPER_CASE)
+STRAIGHT = ("--set", "network.tracks=straight")  # tracks that ignore the city (uamopt/schedule/airspace.py)
 
 
 @pytest.fixture(scope="module")
 def straight_network_file(tmp_path_factory, paper_straight_plan):
     """A network.json whose routes are the straight tracks of ``straight_network`` (not what
-    ``uamopt network`` would plan): flights that fly them prove the file was used."""
+    ``uamopt network`` would plan): flights that fly them prove the file was used. They cross
+    towers, so the commands that read it say ``network.tracks = "straight"`` (``STRAIGHT``)."""
     _, _, network, _ = paper_straight_plan
     path = tmp_path_factory.mktemp("net") / "network.json"
     path.write_text(json.dumps({"routes": {name: {"waypoints": np.asarray(w).tolist()} for name, w in network.items()}}))
@@ -74,7 +76,7 @@ def test_schedule_bad_input(tmp_path, capsys):
 def test_network_option_is_used(tmp_path, capsys, straight_network_file):
     path, routes = straight_network_file
     out = tmp_path / "s"
-    code, _, err = cli(capsys, "schedule", PAPER, "--solver", "greedy", "--network", str(path), "--out", str(out))
+    code, _, err = cli(capsys, "schedule", PAPER, "--solver", "greedy", "--network", str(path), *STRAIGHT, "--out", str(out))
     assert code == 0, err
     flights = flights_of(out)
     assert len(flights) == 120
@@ -89,13 +91,13 @@ def test_seed_option_changes_and_reproduces_the_plan(tmp_path, capsys, straight_
     for name, seed in (("a", "1"), ("b", "2"), ("a_again", "1")):
         outs[name] = tmp_path / name
         code, _, err = cli(capsys, "schedule", PAPER, "--solver", "soa", "--network", str(path), "--seed", seed,
-                           "--set", "schedule.aircraft=6", "--out", str(outs[name]))
+                           *STRAIGHT, "--set", "schedule.aircraft=6", "--out", str(outs[name]))
         assert code == 0, err
     departures = {k: [f["planned_departure_s"] for f in flights_of(v)] for k, v in outs.items()}
     assert departures["a"] == departures["a_again"] and departures["a"] != departures["b"]
     # the same seed reproduces the whole schedule (SOA itself is seeded by its profile)
     assert (outs["a"] / "schedule.csv").read_text() == (outs["a_again"] / "schedule.csv").read_text()
     # the default seed is schedule.plan_seed
-    code, _, _ = cli(capsys, "schedule", PAPER, "--solver", "greedy", "--network", str(path),
+    code, _, _ = cli(capsys, "schedule", PAPER, "--solver", "greedy", "--network", str(path), *STRAIGHT,
                      "--set", "schedule.aircraft=6", "--set", "schedule.plan_seed=2", "--out", str(tmp_path / "d"))
     assert code == 0 and [f["planned_departure_s"] for f in flights_of(tmp_path / "d")] == departures["b"]

@@ -182,22 +182,22 @@ def test_bruteforce_refuses_large_instances(paper_problem):
 
 
 # --- (c) time limit ---------------------------------------------------------------------------
-# Regression value, not the paper's: the optimum of this 180-flight instance (seed 1, 30 aircraft,
-# straight network, Δd at Eq. 29's bound, the paper case's 10 s departure grid; 3705 conflicting
-# pairs) as proven by HiGHS with mip_rel_gap 0 in 50-95 s (bound equal to 1e-13), recorded once.
-REGRESSION_OPTIMUM_SEED1_30_AIRCRAFT = -59.91868292075289
-
-
 def test_highs_time_limit_reports_bound_and_gap(paper_straight_plan):
+    """300 flights (seed 1, 50 aircraft, straight network, Δd at Eq. 29's bound; ~10,500 conflicting
+    pairs): HiGHS does not prove it in 3 s (measured: 20 s leave a 1 % gap), so the run stops at the
+    limit, model building included, with an incumbent and a bound."""
+    from uamopt.solvers.greedy import greedy_decisions
+
     scenario, _, network, _ = paper_straight_plan
-    problem = build_problem(generate_plan(scenario, network, seed=1, aircraft=30, max_delay_scale=1.0), scenario)  # 180 flights
-    schedule = milp.solve(problem, replace(HIGHS, time_limit_s=0.5))
-    print(f"\n{schedule.summary()} {schedule.extras}")
+    problem = build_problem(generate_plan(scenario, network, seed=1, aircraft=50, max_delay_scale=1.0), scenario)
+    started = time.perf_counter()
+    schedule = milp.solve(problem, replace(HIGHS, time_limit_s=3.0))
+    print(f"\n{schedule.summary()} {schedule.extras} wall {time.perf_counter() - started:.2f} s")
     check_feasible(problem, schedule)
-    assert problem.n_flights == 180 and schedule.status == "time_limit"  # 0.5 s is ~1 % of the time to prove it
-    # the incumbent cannot beat the optimum and the bound cannot exceed it
-    assert schedule.objective >= REGRESSION_OPTIMUM_SEED1_30_AIRCRAFT - OBJ_TOL
-    assert schedule.bound <= REGRESSION_OPTIMUM_SEED1_30_AIRCRAFT + OBJ_TOL
+    assert problem.n_flights == 300 and schedule.status == "time_limit" and schedule.bound is not None
+    # the bound lies below every feasible schedule: HiGHS's own (verified above) and greedy's
+    greedy = objective(*greedy_decisions(problem), problem.weights, problem.aircraft_count)  # tests/oracles.py
+    assert schedule.bound <= min(schedule.objective, greedy) + OBJ_TOL
     # the reported gap is the distance between the two relative to the incumbent (bound below it;
     # the incumbent may be 0, every flight cancelled, hence the 1e-10 floor of the denominator)
     distance = schedule.objective - schedule.bound

@@ -188,7 +188,7 @@ def test_fitness_eq36():
 
 @pytest.mark.parametrize("solver, options, match", [
     ("greedy", {"step": 10}, "unknown option 'step'"),
-    ("greedy", {"step_s": 0}, "step_s must be positive"),
+    ("greedy", {"step_s": 0}, "option step_s = 0 out of range"),
     ("soa", {"xi": 1.5}, "option xi = 1.5 out of range"),
     ("ga", {"population": 2.5}, "option population must be int"),
 ])

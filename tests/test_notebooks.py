@@ -1,4 +1,5 @@
-"""Every notebook in notebooks/ runs top to bottom without an error (its asserts are checks).
+"""Every notebook in notebooks/ runs top to bottom without an error (its asserts are checks),
+at the small sizes its first cell picks when ``UAMOPT_NOTEBOOK_SMALL=1`` (full sizes otherwise).
 
 The kernel is this interpreter (``sys.executable``, i.e. the project's venv): the kernel spec
 comes from the ipykernel installed here, never from a ``python3`` kernel spec in the user's
@@ -48,6 +49,7 @@ def test_notebook_runs(path: Path, tmp_path: Path, monkeypatch):
     monkeypatch.setenv("JUPYTER_RUNTIME_DIR", str(tmp_path / "runtime"))
     monkeypatch.setenv("IPYTHONDIR", str(tmp_path / "ipython"))
     monkeypatch.setenv("MPLBACKEND", "Agg")
+    monkeypatch.setenv("UAMOPT_NOTEBOOK_SMALL", "1")  # each notebook's first cell picks its small sizes
     nb = nbformat.read(path, as_version=4)
     client = NotebookClient(
         nb,

@@ -50,9 +50,32 @@ def test_shipped_profile_loads_as_written_and_solves(path):
     ("solver = 'highs'\ntimelimit = 5", "unknown key 'timelimit'"),
     ("time_limit_s = 5", "missing key 'solver'"),
     ("solver = 'gurobi'", "unknown solver 'gurobi'"),
-    ("solver = 'highs'\ntime_limit_s = 0", "time_limit_s must be positive, got 0.0"),
-    ("solver = 'highs'\nthreads = 0", "threads must be at least 1, got 0"),
-    ("solver = 'highs'\ntime_limit_s = 'soon'", "invalid value in solver profile"),
+    ("solver = 'highs'\ntime_limit_s = 0", "time_limit_s must be a positive number of seconds, got 0"),
+    ("solver = 'highs'\nthreads = 0", r"threads must be an integer in \[1, \d+\], got 0"),
+    ("solver = 'highs'\ntime_limit_s = 'soon'", "time_limit_s must be a positive number of seconds, got 'soon'"),
+    ("solver = 'highs'\ntime_limit_s = nan", "time_limit_s must be a positive number"),
+    ("solver = 'highs'\ntime_limit_s = true", "time_limit_s must be a positive number of seconds, got True"),
+    ("solver = 'cpsat'\nseed = -1", r"seed must be an integer in \[0, 2147483647\], got -1"),
+    ("solver = 'cpsat'\nseed = 1e20", r"seed must be an integer in \[0, 2147483647\], got 1e\+20"),
+    ("solver = 'cpsat'\nseed = 100000000000000000000", "seed must be an integer"),
+    ("solver = 'highs'\nseed = '7'", "seed must be an integer in"),
+    ("solver = 'highs'\nseed = true", "seed must be an integer in"),
+    ("solver = 'cpsat'\nthreads = 100000", r"threads must be an integer in \[1, \d+\], got 100000"),
+    ("solver = 'highs'\n[options]\nmip_rel_gap = -1", "HiGHS refuses mip_rel_gap = -1"),
+    ("solver = 'highs'\n[options]\nmip_rel_gap = 'abc'", "HiGHS refuses mip_rel_gap = 'abc'"),
+    ("solver = 'highs'\n[options]\nmip_rel_gap = true", "HiGHS refuses mip_rel_gap = True"),
+    ("solver = 'highs'\n[options]\nmip_gap_rel = 0.1", "HiGHS has no option mip_gap_rel"),
+    ("solver = 'cpsat'\n[options]\nnum_wrokers = 2", "CP-SAT has no parameter num_wrokers"),
+    ("solver = 'cpsat'\n[options]\nlinearization_level = 'high'", "CP-SAT refuses linearization_level = 'high'"),
+    ("solver = 'cpsat'\n[options]\nnum_workers = 4", "option num_workers is set by the profile's threads"),
+    ("solver = 'highs'\n[options]\ntime_limit = 4", "option time_limit is set by the profile's time_limit_s"),
+    ("solver = 'cpsat'\n[options]\ntime_unit_s = 0", "option time_unit_s = 0 out of range"),
+    ("solver = 'greedy'\n[options]\nexact_gaps = 1", "option exact_gaps must be true or false, got 1"),
+    ("solver = 'greedy'\n[options]\nmip_rel_gap = 0", "unknown option 'mip_rel_gap' for solver greedy"),
+    ("solver = 'rolling'\n[options]\ninner = 'gurobi'", "option inner = 'gurobi' is not one of"),
+    ("solver = 'timeindexed'\n[options]\nstep_s = -10", "option step_s = -10 out of range"),
+    ("solver = 'soa'\n[options]\ngenerations = 2.5", "option generations must be int"),
+    ("solver = 'highs'\noptions = 3", "options. must be a table"),
 ])
 def test_bad_profile_is_a_one_line_error(tmp_path, text, match):
     path = tmp_path / "bad.toml"
@@ -61,6 +84,21 @@ def test_bad_profile_is_a_one_line_error(tmp_path, text, match):
         load_profile(path)
     line = info.value.line()
     assert "\n" not in line and " (" in line and "): " in line  # what (where): how to fix
+
+
+def test_non_utf8_profile_is_a_one_line_error(tmp_path):
+    path = tmp_path / "latin1.toml"
+    path.write_bytes("description = 'Zürich'\nsolver = 'greedy'\n".encode("latin-1"))
+    with pytest.raises(UamoptError, match="the profile is not UTF-8 text"):
+        load_profile(path)
+
+
+def test_valid_pass_through_option_is_accepted():
+    """An option HiGHS accepts is not refused and the run still proves the hand-checked optimum
+    (tests/instances.py: cancel A1, fly B1 and C1, W = −0.8)."""
+    problem = crossing_problem("weighted", (0.6, 0.4))
+    proved = solve(problem, SolverProfile("highs", time_limit_s=10, options={"presolve": "off"}))
+    assert proved.status == "optimal" and proved.objective == pytest.approx(-0.8)
 
 
 def test_missing_profile_lists_the_shipped_ones(tmp_path):

@@ -153,9 +153,9 @@ def test_problem_and_objective(paper):
     assert problem.aircraft_count == 20 and problem.weights == (0.6, 0.4)
     assert problem.conflicts and all(c.p < c.q for c in problem.conflicts)
     assert all(fs.flights[c.p].aircraft != fs.flights[c.q].aircraft for c in problem.conflicts)
-    pairs, ptr, intervals = problem.conflict_arrays
-    assert pairs.shape == (len(problem.conflicts), 2) and ptr[-1] == len(intervals)
-    assert np.all(intervals[:, 1] > intervals[:, 0])
+    view = problem.pairs
+    assert len(view) == len(problem.conflicts) and view.ptr[-1] == len(view.lo)
+    assert np.all(view.hi > view.lo)
     on, delay = np.ones(n, bool), np.zeros(n)
     assert evaluate(problem, on, delay) == pytest.approx(-0.4 * 120)
     delay[:3] = [100.0, 200.0, 101.0]

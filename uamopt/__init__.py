@@ -45,7 +45,7 @@ _LAZY = {
     "solve": "uamopt.pipeline", "solver_profile": "uamopt.pipeline", "verify": "uamopt.pipeline",
     "Verification": "uamopt.pipeline",
     "PlanningModel": "uamopt.planning.problem", "TrackPlan": "uamopt.planning.tracks",
-    "RouteNetwork": "uamopt.planning.network",
+    "RouteNetwork": "uamopt.planning.network", "weight_sweep": "uamopt.planning.pareto",
     "FlightSet": "uamopt.schedule.flights", "SchedulingProblem": "uamopt.schedule.model",
     "Schedule": "uamopt.schedule.model", "SolverProfile": "uamopt.solvers",
     "load_risk": "uamopt.io", "load_tracks": "uamopt.io", "load_network": "uamopt.io",

@@ -26,6 +26,17 @@ class _Parser(argparse.ArgumentParser):
         raise SystemExit(EXIT_BAD_INPUT)
 
 
+def _seed(text: str) -> int:
+    """A seed on the command line: a whole number ≥ 0 (numpy's generators refuse negative seeds)."""
+    try:
+        value = int(text)
+    except ValueError:
+        value = -1
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number ≥ 0")
+    return value
+
+
 def _load(args):
     from uamopt.scenario import load_scenario
 
@@ -129,7 +140,7 @@ def build_parser() -> argparse.ArgumentParser:
         return p
 
     def flight_sources(p, seed_only: bool = False):
-        p.add_argument("--seed", type=int, help="seed of the generated plan (default: schedule.plan_seed)")
+        p.add_argument("--seed", type=_seed, help="seed of the generated plan (default: schedule.plan_seed)")
         if not seed_only:
             p.add_argument("--flights", help="flights.json to schedule instead of the generated plan")
             p.add_argument("--network", help="network.json whose routes the flights fly (default: planned now)")
@@ -153,7 +164,7 @@ def build_parser() -> argparse.ArgumentParser:
     bench.add_argument("--solver", nargs="+", required=True, metavar="PROFILE", help="solver profiles")
     bench.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="override keys of every scenario")
     bench.add_argument("--out", default="out/bench", help="output folder (default: out/bench)")
-    bench.add_argument("--seeds", nargs="+", type=int, metavar="SEED",
+    bench.add_argument("--seeds", nargs="+", type=_seed, metavar="SEED",
                        help="solver seeds: a count (--seeds 3 = 0 1 2) or a list (--seeds 0 1 2); default each profile's")
     bench.add_argument("--time-limit", type=float, metavar="SECONDS", help="time limit of every solver (default: each profile's)")
     bench.set_defaults(func=cmd_bench)
@@ -163,7 +174,7 @@ def build_parser() -> argparse.ArgumentParser:
     verify.add_argument("dir", help="folder with flights.json and schedule.csv")
     verify.set_defaults(func=cmd_verify)
     command("reproduce", cmd_reproduce, "run every stage that applies and write report.md with figures", "out/reproduce")
-    from uamopt.experiments.engine import add_sweep_command
+    from uamopt.experiments.commands import add_sweep_command
     from uamopt.export.cli import add_export_commands
 
     add_sweep_command(sub)

@@ -35,8 +35,10 @@ def _file(path: str | Path, name: str) -> Path:
 def _json(path: Path) -> dict:
     try:
         doc = json.loads(path.read_text(encoding="utf-8-sig"))
-    except (ValueError, UnicodeDecodeError) as exc:
+    except (ValueError, UnicodeDecodeError, RecursionError) as exc:
         raise InputFileError(f"malformed JSON: {exc}", str(path), "regenerate the folder with uamopt") from None
+    except OSError as exc:
+        raise InputFileError(f"cannot read {path.name}: {exc.strerror or exc}", str(path), "check that the file is readable") from None
     if not isinstance(doc, dict):
         raise InputFileError("the file does not hold a JSON object", str(path), "regenerate the folder with uamopt")
     return doc

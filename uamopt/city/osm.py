@@ -23,7 +23,7 @@ import pandas as pd
 import shapely
 from pyproj import Transformer
 
-from uamopt.city.geojson import read_geojson
+from uamopt.city.geojson import read_geojson_in, require_on_grid
 from uamopt.city.layers import VectorCity
 from uamopt.errors import InputFileError, ScenarioError
 
@@ -175,7 +175,9 @@ def _load_cached(path: str, mtime_ns: int, bbox: tuple | None, storey_height_m: 
 
     no_fly = []
     if no_fly_path is not None:
-        no_fly = shift(project(np.asarray(read_geojson(Path(no_fly_path), "city.no_fly", ("Polygon",)), dtype=object)))
+        lonlat = read_geojson_in(Path(no_fly_path), "city.no_fly", ("Polygon",), "EPSG:4326")
+        no_fly = shift(project(np.asarray(lonlat, dtype=object)))
+        require_on_grid(no_fly, (float(x1 - x0), float(y1 - y0)), Path(no_fly_path), "city.no_fly")
     roads_local = shift(road_xy)
     origin = inverse.transform(x0, y0)
     counts.update(roads=len(roads_local), road_length_m=float(shapely.length(np.asarray(roads_local)).sum()))

@@ -197,15 +197,13 @@ def cmd_bench(args) -> int:
 
 def _cli_problem(scenario, args):
     """--flights (self-contained or on --network routes), else the generated plan (--seed)."""
-    from uamopt.pipeline import scenario_grid
-    from uamopt.planning.network import load_network
-    from uamopt.schedule import build_problem, load_flights
+    from uamopt.schedule import build_problem
+    from uamopt.workflows import checked_network, scenario_flights
 
     seed = 0 if args.seed is None else args.seed - scenario.schedule.plan_seed
     if not args.flights:
         if args.network:
-            return scheduling_problem(scenario, load_network(args.network), seed)
+            return scheduling_problem(scenario, checked_network(scenario, args.network), seed)
         return scenario_problem(scenario, seed)
-    network = load_network(args.network) if args.network else None
-    flights = load_flights(args.flights, scenario, scenario_grid(scenario), network)
+    flights = scenario_flights(scenario, args.flights, args.network)
     return build_problem(flights, scenario, objective=scenario.schedule.objective)

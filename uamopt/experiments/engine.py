@@ -69,7 +69,8 @@ def connect(scheduler: str | None, workers: int | None, tasks: int, scratch: str
         # was stopped mid-task; worker logs muted (a task's error is in its row)
         with dask.config.set({"temporary-directory": scratch}):
             cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, host="127.0.0.1",
-                                   dashboard_address=None, silence_logs=logging.CRITICAL, env={"TMPDIR": scratch})
+                                   dashboard_address="127.0.0.1:0",  # a free loopback port
+                                   silence_logs=logging.CRITICAL, env={"TMPDIR": scratch})
     finally:
         if main:
             signal.signal(signal.SIGINT, signal.SIG_DFL if previous is None else previous)
@@ -255,15 +256,3 @@ def cmd_sweep(args) -> int:
         sys.stderr.write(f"error: {a['unsaved']} cases were lost by the cluster and not saved ({out}): re-run to retry\n")
         return 1
     return 0
-
-
-def add_sweep_command(sub) -> None:
-    """Register ``uamopt sweep`` on the CLI's subparsers (cli.py calls this)."""
-    p = sub.add_parser("sweep", help="run a sweep file's cases on Dask: results.parquet (resumable)",
-                       description="run a sweep file's cases on Dask: results.parquet (resumable); see docs/sweeps.md")
-    p.add_argument("sweep", help="sweep TOML file, e.g. models/variants/speed.toml")
-    p.add_argument("--out", help="results folder (default: out/sweeps/NAME); re-running into it computes only missing rows")
-    p.add_argument("--scheduler", metavar="ADDRESS", help="a running Dask scheduler, e.g. tcp://127.0.0.1:8786 (default: a local cluster)")
-    p.add_argument("--workers", type=int, metavar="N", help="worker processes of the local cluster (default: CPU count)")
-    p.add_argument("--small", action="store_true", help="apply the file's [small] table (a fast version)")
-    p.set_defaults(func=cmd_sweep)

@@ -138,6 +138,11 @@ def _read(path: Path) -> dict:
         raise ScenarioError(f"malformed TOML: {exc}", str(path), "fix the syntax at that line") from None
     except UnicodeDecodeError:
         raise ScenarioError("sweep file is not UTF-8 text", str(path), "save it as UTF-8 TOML") from None
+    except RecursionError:
+        raise ScenarioError("the sweep file is nested too deeply to read", str(path), "flatten its arrays") from None
+    except OSError as exc:
+        raise ScenarioError(f"cannot read the sweep file: {exc.strerror or exc}", str(path),
+                            "check that the file is readable") from None
 
 
 def _apply_small(raw: dict, where: str) -> dict:
@@ -158,8 +163,8 @@ def _apply_small(raw: dict, where: str) -> dict:
 
 
 def _seeds(raw: Any, where: str) -> tuple[int, ...]:
-    if not isinstance(raw, list) or not raw or not all(isinstance(s, int) and not isinstance(s, bool) for s in raw):
-        raise ScenarioError(f"seeds must be a non-empty list of integers, got {raw!r}", where, "write e.g. seeds = [0, 1, 2]")
+    if not isinstance(raw, list) or not raw or not all(isinstance(s, int) and not isinstance(s, bool) and s >= 0 for s in raw):
+        raise ScenarioError(f"seeds must be a non-empty list of integers ≥ 0, got {raw!r}", where, "write e.g. seeds = [0, 1, 2]")
     if len(set(raw)) != len(raw):
         raise ScenarioError(f"seeds repeat a value: {raw!r}", where, "list each seed once")
     return tuple(raw)

@@ -8,9 +8,11 @@ The georeference of the local frame is :mod:`uamopt.export.frame`; the replay in
 :func:`uamopt.sim.replay`.
 """
 
-from uamopt.export.bluesky import export_bluesky
-from uamopt.export.frame import LocalFrame, scenario_frame
-from uamopt.export.geojson import export_geojson
-from uamopt.export.trajectory import Trajectory, flyable_trajectory
+from uamopt.lazy import lazy_getattr
 
-__all__ = ["LocalFrame", "Trajectory", "export_bluesky", "export_geojson", "flyable_trajectory", "scenario_frame"]
+#: public name -> module (imported on first access, PEP 562: ``uamopt --help`` loads none of them)
+_LAZY = {"export_bluesky": "uamopt.export.bluesky", "LocalFrame": "uamopt.export.frame",
+         "scenario_frame": "uamopt.export.frame", "export_geojson": "uamopt.export.geojson",
+         "Trajectory": "uamopt.export.trajectory", "flyable_trajectory": "uamopt.export.trajectory"}
+__all__ = sorted(_LAZY)
+__getattr__ = lazy_getattr(__name__, _LAZY)

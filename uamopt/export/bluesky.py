@@ -40,6 +40,7 @@ from pathlib import Path
 import numpy as np
 
 from uamopt.errors import UamoptError
+from uamopt.export.defaults import DEFAULT_BANK_DEG, DEFAULT_DT_S, DEFAULT_TRAJECTORY, TRAJECTORIES
 from uamopt.export.folder import ScheduleFolder, read_schedule_folder, write_texts
 from uamopt.export.trajectory import (
     ACCEL_SHARE,
@@ -54,10 +55,6 @@ KT_MPS = 1852.0 / 3600.0
 NM_M = 1852.0
 R_EARTH_BLUESKY_M = 6371000.0  # bluesky.tools.aero.Rearth: the sphere aircraft move on
 AIRCRAFT_TYPE = "EC35"
-DEFAULT_BANK_DEG = 45.0
-DEFAULT_DT_S = 0.05
-TRAJECTORIES = ("designed", "waypoints")
-DEFAULT_TRAJECTORY = "designed"
 
 
 def tas_to_cas(tas_mps: np.ndarray, altitude_m: np.ndarray) -> np.ndarray:

@@ -18,6 +18,8 @@ from pathlib import Path
 
 from uamopt.errors import UamoptError
 
+MAX_DT_S = 10.0  # longest BlueSky clock step accepted, s (the default is 0.05 s)
+
 
 def _pair(text: str | None, option: str, example: str) -> tuple[float, float] | None:
     if text is None:
@@ -32,13 +34,8 @@ def _pair(text: str | None, option: str, example: str) -> tuple[float, float] | 
 
 
 def _simulation_options(p) -> None:
-    from uamopt.export.bluesky import (
-        DEFAULT_BANK_DEG,
-        DEFAULT_DT_S,
-        DEFAULT_TRAJECTORY,
-        TRAJECTORIES,
-    )
-    from uamopt.sim.zone import DEFAULT_BUDGET_H_M, DEFAULT_BUDGET_V_M
+    from uamopt.export.defaults import (DEFAULT_BANK_DEG, DEFAULT_BUDGET_H_M, DEFAULT_BUDGET_V_M, DEFAULT_DT_S,
+                                        DEFAULT_TRAJECTORY, TRAJECTORIES)
 
     p.add_argument("dir", help="a schedule folder written by uamopt schedule")
     p.add_argument("--dt", type=float, default=DEFAULT_DT_S, help=f"BlueSky clock step, s (default {DEFAULT_DT_S:g})")
@@ -54,9 +51,9 @@ def _zone(args, folder_path: str):
     from uamopt.export.folder import read_schedule_folder
     from uamopt.sim.zone import DEFAULT_BUDGET_H_M, DEFAULT_BUDGET_V_M, protected_zone
 
-    if not (args.dt > 0 and math.isfinite(args.dt)) or not 0 < args.bank < 90:
+    if not 0 < args.dt <= MAX_DT_S or not 0 < args.bank < 90:  # a step longer than a flight samples nothing
         raise UamoptError(f"--dt {args.dt:g} or --bank {args.bank:g} out of range", "command line",
-                          "give --dt > 0 s and 0 < --bank < 90 degrees")
+                          f"give 0 < --dt ≤ {MAX_DT_S:g} s and 0 < --bank < 90 degrees")
     budget = _pair(args.budget, "--budget", "10,2") or (DEFAULT_BUDGET_H_M, DEFAULT_BUDGET_V_M)
     flights = read_schedule_folder(folder_path).flights
     return budget, protected_zone(flights.cell, flights.conflict_radius, budget_h_m=budget[0], budget_v_m=budget[1],

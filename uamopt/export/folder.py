@@ -94,9 +94,12 @@ def read_schedule_folder(path: str | Path) -> ScheduleFolder:
     if summary_path.is_file():
         try:
             summary = json.loads(summary_path.read_text(encoding="utf-8-sig"))
-        except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        except (json.JSONDecodeError, UnicodeDecodeError, RecursionError) as exc:
             raise InputFileError(f"malformed JSON: {exc}", str(summary_path), "rewrite it with uamopt schedule") from None
-    raw_frame = summary.get("frame") if isinstance(summary, dict) else None
+        if not isinstance(summary, dict):
+            raise InputFileError("summary.json does not hold a JSON object", str(summary_path),
+                                 "rewrite it with uamopt schedule")
+    raw_frame = summary.get("frame")
     frame = LocalFrame.from_dict(raw_frame, str(summary_path)) if isinstance(raw_frame, dict) else synthetic_frame("default")
     scenario = summary.get("scenario") if isinstance(summary.get("scenario"), dict) else None
     return ScheduleFolder(folder, flights, _operated(folder / "schedule.csv", flights), frame,

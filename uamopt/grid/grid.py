@@ -164,6 +164,18 @@ def check_memory(cell, extent, limit_bytes: int) -> None:
             "grid.cell / grid.extent", "use larger cells or a smaller extent, or raise grid.memory_limit_gb")
 
 
+def file_grid(extent, cell, memory_limit_gb: float | None, source: str) -> AirspaceGrid:
+    """:func:`build_grid` on the cells named by an input file (``flights.json``, ``network.json``):
+    a grid too large for memory is that file's fault, and the error says so."""
+    from uamopt.errors import InputFileError
+
+    try:
+        return build_grid(extent, cell, memory_limit_gb=memory_limit_gb)
+    except GridError as exc:
+        raise InputFileError(f"the file's cell {tuple(float(c) for c in cell)} m: {exc.what}", source,
+                             "give 'cell' as the tracks were planned (e.g. [50, 50, 30]) or raise grid.memory_limit_gb") from None
+
+
 def build_grid(extent, cell, *, memory_limit_gb: float | None = None) -> AirspaceGrid:
     """The grid of whole ``cell``-sized cells inside [0, x_max] × [0, y_max] × [0, z_max] = ``extent``.
 

@@ -111,11 +111,19 @@ class RouteNetwork:
 
     @classmethod
     def from_document(cls, doc: dict) -> RouteNetwork:
+        """The network of a ``network.json`` document, checked field by field (untrusted input).
+
+        Raises ``ValueError`` naming the route: no routes, waypoints that are not at least two
+        finite [x, y, z] points, a track of zero length, a cell that is not three positive sizes."""
+        if not isinstance(doc, dict) or not isinstance(doc.get("routes"), dict) or not doc["routes"]:
+            raise ValueError("'routes' must be a non-empty object of route name -> track")
         routes = {}
         for name, r in doc["routes"].items():
             waypoints = np.asarray(r["waypoints"], dtype=float)
-            if waypoints.ndim != 2 or waypoints.shape[1] != 3 or len(waypoints) < 2:
-                raise ValueError(f"route {name}: waypoints must be a list of at least two [x, y, z]")
+            if waypoints.ndim != 2 or waypoints.shape[1] != 3 or len(waypoints) < 2 or not np.isfinite(waypoints).all():
+                raise ValueError(f"route {name}: waypoints must be a list of at least two finite [x, y, z]")
+            if not np.linalg.norm(np.diff(waypoints, axis=0), axis=1).sum() > 0:
+                raise ValueError(f"route {name}: the track has zero length (its flights would take no time)")
             routes[name] = RouteTrack(
                 name=name, origin=str(r.get("origin", name.split("-")[0])),
                 destination=str(r.get("destination", name.split("-")[-1])), waypoints=waypoints,
@@ -124,6 +132,8 @@ class RouteNetwork:
                 buffer_cost=float(r.get("buffer_cost", np.nan)),
                 layer_k=None if r.get("layer_k") is None else int(r["layer_k"]))
         cell = tuple(float(c) for c in doc.get("cell", (np.nan, np.nan, np.nan)))
+        if "cell" in doc and not (len(cell) == 3 and all(np.isfinite(c) and c > 0 for c in cell)):
+            raise ValueError(f"'cell' must be three positive sizes in metres, got {doc['cell']!r}")
         return cls(routes=routes, cell=cell, scenario=str(doc.get("scenario", "")),  # type: ignore[arg-type]
                    stage=str(doc.get("stage", "optimal")), layering=str(doc.get("layering", "direction")))
 
@@ -202,6 +212,8 @@ def load_network(path: str | Path) -> RouteNetwork:
         return RouteNetwork.from_document(doc)
     except FileNotFoundError:
         raise InputFileError(f"network file not found: {path}", "network.json", "run `uamopt network` first") from None
-    except (ValueError, KeyError, TypeError, AttributeError) as exc:
-        raise InputFileError(f"malformed network file {path}: {exc}", "network.json",
-                             "regenerate it with `uamopt network`") from None
+    except (ValueError, KeyError, TypeError, AttributeError, RecursionError) as exc:
+        raise InputFileError(f"malformed network file: {exc}", str(path), "regenerate it with `uamopt network`") from None
+    except OSError as exc:
+        raise InputFileError(f"cannot read the network file: {exc.strerror or exc}", str(path),
+                             "check the path and the file's permissions") from None

@@ -318,7 +318,7 @@ def plan_track(model: PlanningModel, origin, destination, *, backend: str | None
         Origin or destination outside the grid or band, inside a building, no-fly zone or the
         clearance margin; the track longer than the range L_e (Eq. 17).
     NoTrackError
-        No admissible track joins them.
+        No admissible track joins them, or they lie in the same cell.
     """
     cfg = model.scenario.tracks
     backend = backend or cfg.search
@@ -326,6 +326,10 @@ def plan_track(model: PlanningModel, origin, destination, *, backend: str | None
     o, d = as_endpoint(model.scenario, origin, "origin"), as_endpoint(model.scenario, destination, "destination")
     origin, destination = np.asarray(o.point, dtype=float), np.asarray(d.point, dtype=float)
     start, goal = endpoint_cell(model, origin, "origin", o.where), endpoint_cell(model, destination, "destination", d.where)
+    if start == goal:  # a track needs two cells: the four stages of Fig. 18 start from a path of cells
+        raise NoTrackError(f"origin {o.label} and destination {d.label} lie in the same cell {start}",
+                           f"{o.where} / {d.where}", f"choose end points at least one cell apart (grid.cell = "
+                           f"{', '.join(f'{c:g}' for c in model.field.grid.cell)} m)")
     cell = model.field.grid.cell
     stages: dict[str, TrackStage] = {}
     paths: dict[str, np.ndarray] = {}

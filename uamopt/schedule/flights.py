@@ -33,6 +33,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from uamopt.errors import InputFileError
+from uamopt.schedule.verify import MAX_TIME_S, SPEED_RANGE_MPS  # a file the verifier would refuse is refused first
 
 if TYPE_CHECKING:
     from uamopt.grid import AirspaceGrid
@@ -40,6 +41,7 @@ if TYPE_CHECKING:
 
 DEFAULT_SERVICE_S = 3600.0  # T_f − T_s, s: one hour reproduces F = 6 per aircraft (Eq. 23, Table B.3)
 TIME_TOL_S = 1e-6  # slack for float round-off in time comparisons, s
+MAX_CONFLICT_RADIUS = 10  # r of a flights file: a zone of at most 21³ cells (schedule.conflict_radius's range)
 
 
 def _frozen(array: np.ndarray) -> np.ndarray:
@@ -253,8 +255,15 @@ def flight_from_dict(raw: Any, where: str, network: Mapping[str, np.ndarray] | N
             raise InputFileError(f"'{key}' is not a finite number: {raw[key]!r}", where, f"give '{key}' in seconds or m/s")
     if raw["speed_mps"] <= 0:
         raise InputFileError(f"non-positive speed {raw['speed_mps']!r}", where, "give 'speed_mps' > 0 (v_g, m/s)")
+    if not SPEED_RANGE_MPS[0] <= raw["speed_mps"] <= SPEED_RANGE_MPS[1]:  # what the verifier accepts, checked
+        raise InputFileError(f"speed_mps {raw['speed_mps']:g} is outside {SPEED_RANGE_MPS[0]:g}-{SPEED_RANGE_MPS[1]:g} m/s",
+                             where, "give v_g in m/s (the paper's eVTOL cruises at 25 m/s)")  # before, not after, writing
     if "max_delay_s" in raw and raw["max_delay_s"] < 0:
         raise InputFileError(f"negative max_delay_s {raw['max_delay_s']!r}", where, "give 'max_delay_s' ≥ 0 (Δd, Eq. 29)")
+    for key in ("planned_departure_s", "max_delay_s"):
+        if abs(raw.get(key, 0.0)) > MAX_TIME_S:
+            raise InputFileError(f"'{key}' {raw[key]:g} s is beyond ±{MAX_TIME_S:g} s", where,
+                                 "give times in seconds from the start of service")
     if "waypoints" in raw:
         try:
             wp = np.array(raw["waypoints"], dtype=float)
@@ -373,6 +382,12 @@ def load_flights(
         raise InputFileError(f"malformed JSON: {exc.msg} at line {exc.lineno} column {exc.colno}", source, "fix the syntax") from None
     except UnicodeDecodeError:
         raise InputFileError("flights file is not UTF-8 text", source, "save it as UTF-8 JSON") from None
+    except RecursionError:
+        raise InputFileError("the flights file is nested too deeply to read", source, "give a flights.json as "
+                             "docs/interfaces.md describes") from None
+    except OSError as exc:
+        raise InputFileError(f"cannot read the flights file: {exc.strerror or exc}", source,
+                             "check that the file is readable") from None
     if not isinstance(raw, dict) or not isinstance(raw.get("flights"), list):
         raise InputFileError("missing key 'flights' (a list)", source, 'write {"cell": [...], "conflict_radius": r, "flights": [...]}')
     if not raw["flights"]:
@@ -388,8 +403,9 @@ def load_flights(
         ("outbound_gap_s", sched.outbound_gap_s if sched else 240.0), ("return_gap_s", sched.return_gap_s if sched else 360.0),
     ):
         value = raw.get(key, default)
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value < 0:
-            raise InputFileError(f"'{key}' must be a number ≥ 0, got {value!r}", source, "give it in seconds")
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0 <= value <= MAX_TIME_S:
+            raise InputFileError(f"'{key}' must be a number in [0, {MAX_TIME_S:g}] s, got {value!r}", source,
+                                 "give it in seconds")
         numbers[key] = float(value)
     try:
         cell_t = tuple(float(c) for c in cell)
@@ -397,12 +413,14 @@ def load_flights(
         cell_t = ()
     if len(cell_t) != 3 or not all(math.isfinite(c) and c > 0 for c in cell_t):
         raise InputFileError(f"'cell' must be three positive sizes, got {cell!r}", source, "give [dx, dy, dz] in metres")
-    if isinstance(radius, bool) or not isinstance(radius, int) or radius < 0:
-        raise InputFileError(f"'conflict_radius' must be an integer ≥ 0, got {radius!r}", source, "1 = 3×3×3 zone, 0 = same cell")
+    if isinstance(radius, bool) or not isinstance(radius, int) or not 0 <= radius <= MAX_CONFLICT_RADIUS:
+        raise InputFileError(f"'conflict_radius' must be an integer in [0, {MAX_CONFLICT_RADIUS}], got {radius!r}", source,
+                             "1 = 3×3×3 zone, 0 = same cell (schedule.conflict_radius)")
     if grid is not None and cell_t != tuple(grid.cell):
-        from uamopt.grid import AirspaceGrid
+        from uamopt.grid.grid import file_grid
 
-        grid = AirspaceGrid.from_extent(cell_t, grid.extent)  # the file's cell overrides the scenario's
+        # the file's cell overrides the scenario's, within the same memory limit (tiny cells are refused)
+        grid = file_grid(grid.extent, cell_t, scenario.grid.memory_limit_gb if scenario else None, source)
     flights = tuple(flight_from_dict(f, source, network) for f in raw["flights"])
     flightset = _fill_max_delay(FlightSet(cell=cell_t, conflict_radius=radius, flights=flights, **numbers))
     check_flightset(flightset, grid, source)

@@ -17,9 +17,14 @@ Constraints (docs/readings.md, Scheduling):
 4. Service end (Eq. 26) and delay threshold (Eq. 29): 0 ≤ d_f ≤ delay_upper_s[f]
    = min(Δd_f, T_f − planned arrival_f).
 
+5. Must operate: c_f = 1 where ``must_operate[f]`` (none in the paper's model).
+
 Objective (Eqs. 20-22): ``"weighted"``: W = ω6·Σ_f c_f d_f / G − ω7·Σ_f c_f (minimised);
 ``"lexicographic"``: most operated flights first, then least total delay, as the scalar
 −S + Σ c d / (Σ delay_upper + 1) (the delay term lies in [0, 1), so S decides first).
+
+The objective, the pair view of the conflicts and "must operate" are defined once, in
+:mod:`uamopt.schedule.core`, as ``problem.objective``, ``problem.pairs`` and ``problem.must_operate``.
 """
 
 from __future__ import annotations
@@ -34,6 +39,7 @@ from typing import TYPE_CHECKING, Literal
 import numpy as np
 
 from uamopt.errors import UamoptError
+from uamopt.schedule.core import Objective, PairView, pair_view
 from uamopt.schedule.flights import TIME_TOL_S, FlightSet, save_flights
 from uamopt.schedule.occupancy import ConflictTable, conflict_table
 
@@ -50,17 +56,38 @@ class SchedulingProblem:
     """The model (data). Build it with :func:`build_problem`; any solver takes it as it is."""
 
     flights: FlightSet
-    conflicts: ConflictTable  # a sequence of PairConflict(p, q, intervals); arrays in conflict_arrays
+    conflicts: ConflictTable  # a sequence of PairConflict(p, q, intervals); named arrays in ``pairs``
     weights: tuple[float, float] = (0.6, 0.4)  # (ω6, ω7), Eq. 20
     aircraft_count: int = 0  # G, Eq. 21: the number of distinct aircraft in ``flights`` (0: fill it in)
     objective_kind: ObjectiveKind = "weighted"
     time_step_s: float = 10.0  # ΔT_a (Table B.3): the heuristics' delay grid unless a profile sets step_s
+    must_operate: np.ndarray | None = None  # (n,) bool: flights that may not be cancelled (core.py); None: none
 
     def __post_init__(self) -> None:
         if self.objective_kind not in ("weighted", "lexicographic"):
             raise UamoptError(f"unknown objective '{self.objective_kind}'", "schedule objective", "use weighted or lexicographic")
         if self.aircraft_count <= 0:
             object.__setattr__(self, "aircraft_count", self.flights.n_aircraft)
+        must = np.zeros(len(self.flights), dtype=bool) if self.must_operate is None else np.asarray(self.must_operate, dtype=bool)
+        if must.shape != (len(self.flights),):
+            raise UamoptError(f"must_operate has shape {must.shape}, not ({len(self.flights)},)", "SchedulingProblem",
+                              "give one bool per flight")
+        must.setflags(write=False)
+        object.__setattr__(self, "must_operate", must)
+
+    @cached_property
+    def objective(self) -> Objective:
+        """The objective's coefficients (Eqs. 20-22 or the lexicographic scalar; core.py)."""
+        if self.objective_kind == "lexicographic":
+            return Objective.lexicographic(self.delay_upper_s)
+        w6, w7 = self.weights
+        return Objective.weighted(w6, w7, self.aircraft_count)
+
+    @cached_property
+    def pairs(self) -> PairView:
+        """The conflicting pairs: forbidden intervals, reach and admissible gaps of δ (core.py)."""
+        c = self.conflicts
+        return pair_view(c.p, c.q, c.ptr, c.intervals, self.planned_departure_s, self.delay_upper_s)
 
     @property
     def n_flights(self) -> int:
@@ -98,13 +125,6 @@ class SchedulingProblem:
         """Flight indices of each aircraft, in order."""
         return self.flights.chains
 
-    @property
-    def conflict_arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """The conflicts in CSR form: ``pairs`` (m, 2), ``ptr`` (m + 1,), ``intervals`` (K, 2);
-        pair k forbids dep_q − dep_p in the open intervals ``intervals[ptr[k]:ptr[k+1]]``."""
-        c = self.conflicts
-        return np.stack([c.p, c.q], axis=1), c.ptr, c.intervals
-
 
 def build_problem(
     flightset: FlightSet,
@@ -130,12 +150,7 @@ def build_problem(
 def evaluate(problem: SchedulingProblem, operated: np.ndarray, delay_s: np.ndarray) -> float:
     """The objective of a decision (feasible or not): Eq. 20 or the lexicographic scalar."""
     c = np.asarray(operated, dtype=bool)
-    total_delay = float(np.sum(np.where(c, np.asarray(delay_s, dtype=float), 0.0)))
-    flights = int(c.sum())
-    if problem.objective_kind == "lexicographic":
-        return -flights + total_delay / (float(np.sum(problem.delay_upper_s)) + 1.0)
-    w6, w7 = problem.weights
-    return w6 * total_delay / problem.aircraft_count - w7 * flights  # Eqs. 20-22
+    return problem.objective.value(int(c.sum()), float(np.sum(np.where(c, np.asarray(delay_s, dtype=float), 0.0))))
 
 
 def violations(problem: SchedulingProblem, operated: np.ndarray, delay_s: np.ndarray, tol_s: float = TIME_TOL_S) -> list[str]:
@@ -149,6 +164,8 @@ def violations(problem: SchedulingProblem, operated: np.ndarray, delay_s: np.nda
     out: list[str] = []
     for i in np.flatnonzero(c & ((d < -tol_s) | (d > problem.delay_upper_s + tol_s))):
         out.append(f"flight {ids[i]}: delay {d[i]:g} s outside [0, {problem.delay_upper_s[i]:g}] s")
+    for i in np.flatnonzero(problem.must_operate & ~c):
+        out.append(f"flight {ids[i]}: must operate but is cancelled")
     req = problem.requires
     for i in np.flatnonzero(c & (req >= 0)):
         if not c[req[i]]:
@@ -161,14 +178,13 @@ def violations(problem: SchedulingProblem, operated: np.ndarray, delay_s: np.nda
             if dep[f] < arr[e] + problem.turnaround_after_s[e] - tol_s:
                 out.append(f"flight {ids[f]}: departs {dep[f]:.3f} s, before {ids[e]}'s arrival + turnaround "
                            f"{arr[e] + problem.turnaround_after_s[e]:.3f} s")
-    pairs, ptr, intervals = problem.conflict_arrays
-    pair_of_row = np.repeat(np.arange(len(pairs)), np.diff(ptr))
-    p, q = pairs[pair_of_row, 0], pairs[pair_of_row, 1]
+    view = problem.pairs
+    p, q = view.p[view.row_pair], view.q[view.row_pair]
     delta = dep[q] - dep[p]
-    bad = c[p] & c[q] & (intervals[:, 0] + tol_s < delta) & (delta < intervals[:, 1] - tol_s)
+    bad = c[p] & c[q] & (view.lo + tol_s < delta) & (delta < view.hi - tol_s)
     for row in np.flatnonzero(bad):
         out.append(f"flights {ids[p[row]]} and {ids[q[row]]}: departure gap {delta[row]:.3f} s in forbidden "
-                   f"({intervals[row, 0]:.3f}, {intervals[row, 1]:.3f})")
+                   f"({view.lo[row]:.3f}, {view.hi[row]:.3f})")
     return out
 
 

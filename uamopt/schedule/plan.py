@@ -171,6 +171,9 @@ def generate_plan(
     """
     if callable(getattr(network, "waypoints", None)):  # a RouteNetwork
         network = network.waypoints()
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise UamoptError(f"the plan seed must be a whole number ≥ 0, got {seed!r}", "--seed / schedule.plan_seed",
+                          "give 0, 1, 2, ...")
     sched = scenario.schedule
     n_aircraft = sched.aircraft if aircraft is None else int(aircraft)
     total = sched.flights if flights is None else int(flights)

@@ -21,8 +21,10 @@ Rules checked (tolerance ``TOL_S`` = 1e-6 s on every time):
 
 The folder is untrusted input: a field out of its range (a negative or non-integer conflict
 radius, a cell that is not positive, waypoints that are not finite or lie outside the local
-frame, a speed outside 0.1–200 m/s, times beyond 10⁷ s, a summary that is not an object, text
-that is not UTF-8) is an ``InputFileError`` (exit 2), never a pass.
+frame, a speed outside 0.1–200 m/s, times beyond 10⁷ s, a flight id twice, a conflict search
+beyond ``MAX_VISITS`` cells (millimetre cells), a summary that is not an object or whose weights
+are not two numbers, text that is not UTF-8) is an ``InputFileError`` (exit 2), never a pass; a
+waypoint outside the grid ``extent_m`` that summary.json records is a violation (exit 1).
 
 Cell convention (shared by definition with the model, not by code): cell = floor(coordinate / Δ);
 when a segment starts exactly on a plane and moves down that axis it is in the lower cell; a
@@ -39,8 +41,8 @@ from collections import defaultdict
 from pathlib import Path
 
 from uamopt.errors import InputFileError
+from uamopt.schedule.verify_summary import TOL_S, check_summary, close
 
-TOL_S = 1e-6  # s
 TIE_S = 1e-9  # crossings closer than this are simultaneous, s
 BUCKET_S = 30.0  # time bucket of the conflict hash, s
 BLOCK = 3  # cells per axis in a block of the conflict hash (≥ r)
@@ -48,6 +50,7 @@ MAX_RADIUS = 10  # conflict zone of at most 21³ cells
 SPEED_RANGE_MPS = (0.1, 200.0)  # ground speeds a flight file may claim, m/s
 MAX_TIME_S = 1e7  # |planned departure| and delay bounds, s (about 116 days)
 MAX_COORD_M = 1e6  # waypoint coordinates of the local frame, m (1,000 km)
+MAX_VISITS = 10_000_000  # cell visits and time buckets the conflict search may hold (about 1 GB)
 COLUMNS = ["flight", "aircraft", "route", "operated", "planned_departure_s", "delay_s", "departure_s", "arrival_s"]
 
 
@@ -123,7 +126,7 @@ def _read_flights(path: Path) -> dict:
         raw = json.loads(path.read_text(encoding="utf-8-sig"))
         flights = raw["flights"]
         cell = [_number(c, "cell", str(path)) for c in raw["cell"]]
-    except (json.JSONDecodeError, UnicodeDecodeError, RecursionError) as exc:
+    except (json.JSONDecodeError, UnicodeDecodeError, RecursionError, OSError) as exc:
         raise InputFileError(f"malformed JSON: {exc}", str(path), "rewrite the file with uamopt schedule") from None
     except (KeyError, TypeError, ValueError):
         raise InputFileError("missing or malformed 'flights' or 'cell'", str(path), "rewrite the file with uamopt schedule") from None
@@ -140,6 +143,7 @@ def _read_flights(path: Path) -> dict:
         "gaps": (_number(raw.get("outbound_gap_s", 240.0), "outbound_gap_s", str(path)),
                  _number(raw.get("return_gap_s", 360.0), "return_gap_s", str(path))),
     }
+    seen: set[str] = set()
     for f in flights:
         where = f"{path}: flight {f.get('id') if isinstance(f, dict) else '?'}"
         if not isinstance(f, dict) or "waypoints" not in f:
@@ -167,9 +171,27 @@ def _read_flights(path: Path) -> dict:
         if any(v < 0 for p in wps for v in p) or any(abs(v) > MAX_COORD_M for p in wps for v in p):
             raise InputFileError(f"waypoints outside the local frame [0, {MAX_COORD_M:g}] m (below the ground datum "
                                  "or west/south of the grid's origin)", where, "rewrite the file with uamopt schedule")
+        if rec["id"] in seen:
+            raise InputFileError(f"flight id {rec['id']!r} appears twice", where, "give every flight its own id")
+        seen.add(rec["id"])
         rec["length"] = sum(math.dist(a, b) for a, b in itertools.pairwise(wps))
         out["flights"].append(rec)
+    _check_work(out, str(path))
     return out
+
+
+def _check_work(spec: dict, where: str) -> None:
+    """Refuse a folder whose conflict search would walk more than ``MAX_VISITS`` cells and time
+    buckets (millimetre cells or week-long crawls): bounded memory on hostile input."""
+    cell, work = spec["cell"], 0.0
+    for f in spec["flights"]:
+        for a, b in itertools.pairwise(f["waypoints"]):
+            work += 1 + sum(abs(b[k] - a[k]) / cell[k] for k in range(3))
+        work += f["length"] / f["speed"] / BUCKET_S
+    if work > MAX_VISITS:
+        raise InputFileError(f"the conflict search would visit about {work:.3g} cells and time buckets "
+                             f"(cell {', '.join(f'{c:g}' for c in cell)} m), more than {MAX_VISITS:.0e}", where,
+                             "rewrite the folder with uamopt schedule (cells in metres, as planned)")
 
 
 def _read_schedule(path: Path) -> dict[str, dict]:
@@ -180,7 +202,7 @@ def _read_schedule(path: Path) -> dict[str, dict]:
         return _parse_schedule(path, rows)
     except UnicodeDecodeError:
         raise InputFileError("schedule.csv is not UTF-8 text", str(path), "save it as UTF-8 CSV") from None
-    except csv.Error as exc:
+    except (csv.Error, OSError) as exc:
         raise InputFileError(f"malformed CSV: {exc}", str(path), "rewrite it with uamopt schedule") from None
 
 
@@ -259,10 +281,6 @@ def _conflicts(flights: list[dict], cell, radius: int) -> list[str]:
     return out
 
 
-def _close(a: float, b: float) -> bool:
-    return abs(a - b) <= TOL_S * max(1.0, abs(a), abs(b))
-
-
 def verify_files(flights_path: Path, schedule_path: Path, summary_path: Path | None = None) -> list[str]:
     """Violations of the schedule in ``schedule_path`` for the flights of ``flights_path``."""
     spec = _read_flights(flights_path)
@@ -283,7 +301,7 @@ def verify_files(flights_path: Path, schedule_path: Path, summary_path: Path | N
             out.append(f"flight {f['id']}: listed more than once in schedule.csv")
         if row["row"]["aircraft"] != f["aircraft"] or row["row"]["route"] != f["route"]:
             out.append(f"flight {f['id']}: aircraft/route in schedule.csv differ from flights.json")
-        if not _close(row["planned"], f["planned"]):
+        if not close(row["planned"], f["planned"]):
             out.append(f"flight {f['id']}: planned departure {row['planned']} differs from flights.json's {f['planned']}")
         f["operated"] = row["operated"]
         if not row["operated"]:
@@ -292,9 +310,9 @@ def verify_files(flights_path: Path, schedule_path: Path, summary_path: Path | N
         f["departure"], f["arrival"] = row["departure"], row["arrival"]
         if d < -TOL_S or d > f["max_delay"] + TOL_S:
             out.append(f"flight {f['id']}: delay {d:g} s outside [0, {f['max_delay']:g}] s (Eq. 29)")
-        if not _close(f["departure"], f["planned"] + d):
+        if not close(f["departure"], f["planned"] + d):
             out.append(f"flight {f['id']}: departure {f['departure']} s ≠ planned {f['planned']} + delay {d} s")
-        if not _close(f["arrival"], f["departure"] + f["length"] / f["speed"]):
+        if not close(f["arrival"], f["departure"] + f["length"] / f["speed"]):
             out.append(f"flight {f['id']}: arrival {f['arrival']} s ≠ departure + track length / speed "
                        f"= {f['departure'] + f['length'] / f['speed']:.6f} s")
         if f["arrival"] > spec["service_end_s"] + TOL_S:
@@ -318,35 +336,7 @@ def verify_files(flights_path: Path, schedule_path: Path, summary_path: Path | N
             last = (f, leg)
     out += _conflicts(flown, spec["cell"], spec["radius"])
     if summary_path is not None and summary_path.is_file():
-        out += _check_summary(summary_path, spec, flown, len(by_aircraft))
-    return out
-
-
-def _check_summary(path: Path, spec: dict, flown: list[dict], n_aircraft: int) -> list[str]:
-    try:
-        summary = json.loads(path.read_text(encoding="utf-8-sig"))
-    except (json.JSONDecodeError, UnicodeDecodeError, RecursionError) as exc:
-        raise InputFileError(f"malformed JSON: {exc}", str(path), "rewrite it with uamopt schedule") from None
-    if not isinstance(summary, dict):
-        raise InputFileError("summary.json does not hold a JSON object", str(path), "rewrite it with uamopt schedule")
-    out: list[str] = []
-    total = sum(f["delay"] for f in flown)
-    expect = {"operated": len(flown), "cancelled": len(spec["flights"]) - len(flown),
-              "total_delay_s": total, "avg_delay_s": total / n_aircraft}
-    if summary.get("status") != "infeasible" and summary.get("objective") is not None and "weights" in summary:
-        w6, w7 = summary["weights"]
-        if summary.get("objective_kind", "weighted") == "weighted":
-            expect["objective"] = w6 * total / n_aircraft - w7 * len(flown)
-        else:
-            upper = sum(max(0.0, min(f["max_delay"], spec["service_end_s"] - f["planned"] - f["length"] / f["speed"]))
-                        for f in spec["flights"])
-            expect["objective"] = -len(flown) + total / (upper + 1.0)
-    for key, value in expect.items():
-        got = summary.get(key)
-        if not isinstance(got, (int, float)) or not _close(float(got), float(value)):
-            out.append(f"summary.json: {key} = {got!r}, the schedule gives {value:.6g}")
-    if summary.get("status") not in ("optimal", "feasible", "time_limit", "infeasible", "error"):
-        out.append(f"summary.json: unknown status {summary.get('status')!r}")
+        out += check_summary(summary_path, spec, flown, len(by_aircraft))
     return out
 
 

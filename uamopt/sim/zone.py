@@ -33,9 +33,8 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass
 
 from uamopt.errors import UamoptError
+from uamopt.export.defaults import DEFAULT_BUDGET_H_M, DEFAULT_BUDGET_V_M
 
-DEFAULT_BUDGET_H_M = 10.0  # e_h, m: paper case, designed trajectory ≤ 7.81 m + BlueSky ≤ 1.63 m (docs/export.md)
-DEFAULT_BUDGET_V_M = 2.0  # e_v: largest vertical deviation allowed from the plan, m
 MARGIN_M = 0.5  # m: spherical vs projected distance at 30 m (≤ 0.3 %), float rounding at the boundary
 
 

@@ -10,6 +10,8 @@ Profiles are TOML files in ``solvers/`` naming a solver and its options::
     threads = 2
     [options]               # solver-specific (see each module's docstring)
     mip_rel_gap = 0.0
+
+Every field and option is typed and checked when the profile is made (:mod:`uamopt.solvers.options`).
 """
 
 from __future__ import annotations
@@ -41,7 +43,9 @@ _KEYS = {"solver", "time_limit_s", "seed", "threads", "options", "description"}
 
 @dataclass(frozen=True)
 class SolverProfile:
-    """A solver and its options; ``name`` is the profile's file stem."""
+    """A solver and its options, typed and checked on creation (:mod:`uamopt.solvers.options`):
+    an unknown option or an invalid value is refused here, before any work; ``name`` is the
+    profile's file stem. ``time_limit_s`` bounds the whole solve, model building included."""
 
     solver: str
     name: str = ""
@@ -51,14 +55,24 @@ class SolverProfile:
     options: dict = field(default_factory=dict)
 
     def __post_init__(self) -> None:
-        if self.solver not in SOLVERS:
-            raise UamoptError(f"unknown solver '{self.solver}'", f"profile {self.name or self.solver}",
+        from uamopt.solvers.options import check_options, check_profile_fields
+
+        if not isinstance(self.solver, str) or self.solver not in SOLVERS:
+            raise UamoptError(f"unknown solver {self.solver!r}", f"profile {self.name or self.solver}",
                               f"use one of {', '.join(SOLVERS)}")
-        if not self.time_limit_s > 0:
-            raise UamoptError(f"time_limit_s must be positive, got {self.time_limit_s}", f"profile {self.name}",
-                              "give a time limit in seconds")
-        if self.threads < 1:
-            raise UamoptError(f"threads must be at least 1, got {self.threads}", f"profile {self.name}", "use 1 or more")
+        check_profile_fields(self.name or self.solver, self.time_limit_s, self.seed, self.threads)
+        check_options(self.solver, self.options, self.name or self.solver)
+
+    def option(self, key: str, default=None):
+        """The typed value of option ``key`` (checked on creation), else its declared default
+        (:data:`uamopt.solvers.options.OWN`), else ``default``."""
+        from uamopt.solvers.options import OWN
+
+        if key in self.options:
+            spec = OWN.get(self.solver, {}).get(key)
+            return spec.kind(self.options[key]) if spec is not None else self.options[key]
+        spec = OWN.get(self.solver, {}).get(key)
+        return spec.default if spec is not None and spec.default is not None else default
 
 
 def load_profile(name_or_path: str | Path) -> SolverProfile:
@@ -76,17 +90,18 @@ def load_profile(name_or_path: str | Path) -> SolverProfile:
         raw = tomllib.loads(path.read_text(encoding="utf-8"))
     except tomllib.TOMLDecodeError as exc:
         raise ScenarioError(f"malformed TOML: {exc}", str(path), "fix the syntax at that line") from None
+    except UnicodeDecodeError:
+        raise ScenarioError("the profile is not UTF-8 text", str(path), "save it as UTF-8") from None
+    except (OSError, RecursionError) as exc:
+        raise ScenarioError(f"cannot read the profile: {getattr(exc, 'strerror', None) or exc}", str(path),
+                            "give a readable TOML file") from None
     unknown = set(raw) - _KEYS
     if unknown:
         raise ScenarioError(f"unknown key '{sorted(unknown)[0]}'", str(path), f"valid keys are {', '.join(sorted(_KEYS))}")
     if "solver" not in raw:
         raise ScenarioError("missing key 'solver'", str(path), f"name one of {', '.join(SOLVERS)}")
-    try:
-        return SolverProfile(solver=str(raw["solver"]), name=path.stem, time_limit_s=float(raw.get("time_limit_s", 60.0)),
-                             seed=int(raw.get("seed", 0)), threads=int(raw.get("threads", 2)),
-                             options=dict(raw.get("options", {})))
-    except (TypeError, ValueError) as exc:
-        raise ScenarioError(f"invalid value in solver profile: {exc}", str(path), "see uamopt/solvers/__init__.py") from None
+    return SolverProfile(solver=raw["solver"], name=path.stem, time_limit_s=raw.get("time_limit_s", 60.0),
+                         seed=raw.get("seed", 0), threads=raw.get("threads", 2), options=raw.get("options", {}))
 
 
 def solve(problem: SchedulingProblem, profile: SolverProfile | str) -> Schedule:

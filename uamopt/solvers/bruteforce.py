@@ -1,10 +1,12 @@
 """An exact reference for *tiny* instances (≤ ``MAX_FLIGHTS`` flights): a test oracle, not a solver.
 
 It shares nothing with ``milp.py`` or ``cpsat.py`` beyond the model data of
-:class:`SchedulingProblem` (Sec. 4.3) and enumerates instead of modelling:
+:class:`SchedulingProblem` (Sec. 4.3) and its core (``problem.objective``, the admissible gaps of
+``problem.pairs``, ``problem.must_operate``; uamopt.schedule.core, tested on its own against
+hand-made pairs) and enumerates instead of modelling:
 
 1. every operate/cancel vector c ∈ {0, 1}ⁿ that keeps the precedence (a return needs its
-   outbound), most operated flights first;
+   outbound) and operates every must-operate flight, most operated flights first;
 2. for a fixed c the objective (Eqs. 20-22) only needs the least total delay Σ d_f. Each pair
    of operated flights with forbidden open intervals of δ = dep_q − dep_p must put δ in one of
    the closed gaps between them (within δ's reachable range); for a fixed choice of gaps every
@@ -31,28 +33,6 @@ from uamopt.schedule.model import Schedule, SchedulingProblem, make_schedule
 
 MAX_FLIGHTS = 10  # 2¹⁰ operate vectors; beyond that use ``highs``
 LP_TOL = 1e-7  # the LP's own accuracy on Σ d, s
-
-
-def _objective(problem: SchedulingProblem, operated: int, total_delay_s: float) -> float:
-    """Eqs. 20-22 or model.py's lexicographic scalar, written out again on purpose."""
-    if problem.objective_kind == "lexicographic":
-        return -operated + total_delay_s / (float(np.sum(problem.delay_upper_s)) + 1.0)
-    w6, w7 = problem.weights
-    return w6 * total_delay_s / problem.aircraft_count - w7 * operated
-
-
-def _gap_choices(problem: SchedulingProblem) -> list[tuple[int, int, list[tuple[float, float]]]]:
-    """Per conflict pair: the closed gaps of δ between its forbidden open intervals, within reach."""
-    out = []
-    dep, upper = problem.planned_departure_s, problem.delay_upper_s
-    for conflict in problem.conflicts:
-        p, q = conflict.p, conflict.q
-        low, high = dep[q] - dep[p] - upper[p], dep[q] - dep[p] + upper[q]
-        edges = [low] + [v for row in np.asarray(conflict.intervals).tolist() for v in row] + [high]
-        # gaps are [edges[2i], edges[2i+1]]: from the reach's start or an interval's end to the next start
-        gaps = [(max(a, low), min(b, high)) for a, b in zip(edges[0::2], edges[1::2])]
-        out.append((p, q, [(a, b) for a, b in gaps if a <= b and a <= high and b >= low]))
-    return out
 
 
 def _lp(problem: SchedulingProblem, flown: list[int], rows: list[tuple[int, int, float]]):
@@ -84,7 +64,9 @@ def least_delay(problem: SchedulingProblem, operated: np.ndarray) -> tuple[float
         mine = [int(f) for f in chain if operated[f]]
         fixed += [(e, f, dep[f] - dep[e] - time_s[e] - gap[e]) for i, e in enumerate(mine) for f in mine[i + 1:]]
     branching = []
-    for p, q, gaps in _gap_choices(problem):
+    view = problem.pairs  # the admissible-gap view (uamopt.schedule.core)
+    for k, (p, q) in enumerate(zip(view.p.tolist(), view.q.tolist())):
+        gaps = view.gaps_of(k)
         if not (operated[p] and operated[q]):
             continue
         if not gaps:
@@ -125,17 +107,19 @@ def solve(problem: SchedulingProblem, profile=None) -> Schedule:
     if n > MAX_FLIGHTS:
         raise UamoptError(f"{n} flights is too many for the brute force", "bruteforce", f"use at most {MAX_FLIGHTS} or the highs solver")
     start = time.perf_counter()
-    requires = problem.requires
+    requires, must, objective = problem.requires, problem.must_operate, problem.objective
     vectors = [np.array(c, dtype=bool) for c in itertools.product((True, False), repeat=n)]
-    vectors = [c for c in vectors if all(requires[f] < 0 or c[requires[f]] for f in np.flatnonzero(c))]
+    vectors = [c for c in vectors if all(requires[f] < 0 or c[requires[f]] for f in np.flatnonzero(c)) and c[must].all()]
     vectors.sort(key=lambda c: -int(c.sum()))  # stable: ties keep the product order
     best_value, best = np.inf, None
     for c in vectors:
-        if _objective(problem, int(c.sum()), 0.0) >= best_value - 1e-12:
+        if objective.value(int(c.sum()), 0.0) >= best_value - 1e-12:
             break  # every later vector operates no more flights
         found = least_delay(problem, c)
-        if found is not None and _objective(problem, int(c.sum()), found[0]) < best_value:
-            best_value, best = _objective(problem, int(c.sum()), found[0]), (c, found[1])
-    assert best is not None  # cancelling every flight is always feasible
+        if found is not None and objective.value(int(c.sum()), found[0]) < best_value:
+            best_value, best = objective.value(int(c.sum()), found[0]), (c, found[1])
+    if best is None:  # only with must-operate flights: cancelling every other flight is always feasible
+        return make_schedule(problem, "bruteforce", "infeasible", np.zeros(n, bool), np.zeros(n),
+                             solve_seconds=time.perf_counter() - start, extras={"vectors": len(vectors)})
     return make_schedule(problem, "bruteforce", "optimal", best[0], best[1], bound=best_value,
                          solve_seconds=time.perf_counter() - start, extras={"vectors": len(vectors)})

@@ -36,8 +36,8 @@ Profile options: ``time_unit_s`` (default 0.01); ``threads`` → ``num_workers``
 
 from __future__ import annotations
 
+import dataclasses
 import math
-from fractions import Fraction
 
 import numpy as np
 
@@ -50,13 +50,14 @@ ROUND_S = 1e-9  # float round-off accepted when rounding a real time to units, s
 INT_LIMIT = 2**62  # keep |objective| below this (CP-SAT uses int64)
 
 
-def _objective(problem: SchedulingProblem, unit_s: float, delay_max: np.ndarray) -> tuple[int, int, float, str]:
-    """Integer coefficients (per unit of delay, per operated flight), the divisor back to W, and how."""
+def integer_objective(problem: SchedulingProblem, unit_s: float, delay_max: np.ndarray) -> tuple[int, int, float, str]:
+    """Integer coefficients (per unit of delay, per operated flight) of ``problem.objective``, the
+    divisor back to W, and how."""
     total = int(delay_max.sum()) + 1
-    if problem.objective_kind == "lexicographic":
+    objective = problem.objective
+    if objective.exact is None:  # lexicographic: one flight outweighs every delay unit together
         return 1, total, 1.0, "lexicographic"
-    w6, w7 = (Fraction(repr(float(w))) for w in problem.weights)
-    per_unit, per_flight = w6 * Fraction(repr(float(unit_s))) / problem.aircraft_count, w7
+    per_unit, per_flight = objective.scaled_delay(unit_s), objective.exact[1]
     scale = math.lcm(per_unit.denominator, per_flight.denominator)
     a, b = int(per_unit * scale), int(per_flight * scale)
     if (abs(a) * total + abs(b) * len(delay_max)) < INT_LIMIT:
@@ -85,6 +86,8 @@ def build_cpsat(problem: SchedulingProblem, unit_s: float = 0.01, rounding: str 
         model.add(delay[f] == 0).only_enforce_if(operate[f].Not())
         if problem.requires[f] >= 0:
             model.add_implication(operate[f], operate[int(problem.requires[f])])
+    for f in np.flatnonzero(problem.must_operate).tolist():
+        model.add(operate[f] == 1)
     for chain in problem.chains:
         for i, e in enumerate(chain.tolist()):
             for f in chain[i + 1:].tolist():
@@ -93,35 +96,35 @@ def build_cpsat(problem: SchedulingProblem, unit_s: float = 0.01, rounding: str 
                         else math.floor((need - TIME_TOL_S) / unit_s - 1 - eta) + 1)
                 if need > -delay_max[e]:
                     model.add(delay[f] - delay[e] >= need).only_enforce_if([operate[e], operate[f]])
-    pairs, ptr, intervals = problem.conflict_arrays
-    for k, (p, q) in enumerate(pairs.tolist()):
-        shift = dep[q] - dep[p]
+    view = problem.pairs
+    for k, (p, q) in enumerate(zip(view.p.tolist(), view.q.tolist())):
+        shift, rows = float(view.shift[k]), slice(view.ptr[k], view.ptr[k + 1])
         reach = Domain(-int(delay_max[p]), int(delay_max[q]))
         if rounding == "outer":
             forbidden = [[math.floor((lo - shift) / unit_s + eta) + 1, math.ceil((hi - shift) / unit_s - eta) - 1]
-                         for lo, hi in intervals[ptr[k]:ptr[k + 1]].tolist()]
+                         for lo, hi in zip(view.lo[rows].tolist(), view.hi[rows].tolist())]
         else:
             forbidden = [[math.ceil((lo + TIME_TOL_S - shift) / unit_s + 1 + eta),
                           math.floor((hi - TIME_TOL_S - shift) / unit_s - 1 - eta)]
-                         for lo, hi in intervals[ptr[k]:ptr[k + 1]].tolist()]
+                         for lo, hi in zip(view.lo[rows].tolist(), view.hi[rows].tolist())]
         forbidden = [iv for iv in forbidden if iv[0] <= iv[1]]
         allowed = reach.intersection_with(Domain.from_intervals(forbidden).complement()) if forbidden else reach
         if allowed.is_empty():
             model.add_bool_or([operate[p].Not(), operate[q].Not()])
         elif allowed.size() < reach.size():
             model.add_linear_expression_in_domain(delay[q] - delay[p], allowed).only_enforce_if([operate[p], operate[q]])
-    per_unit, per_flight, divisor, how = _objective(problem, unit_s, delay_max)
+    per_unit, per_flight, divisor, how = integer_objective(problem, unit_s, delay_max)
     model.minimize(per_unit * sum(delay) - per_flight * sum(operate))
     return model, operate, delay, per_unit, per_flight, divisor, how
 
 
-def _bound(problem: SchedulingProblem, raw: float, per_flight: int, divisor: float, unit_s: float, how: str) -> float:
+def objective_bound(problem: SchedulingProblem, raw: float, per_flight: int, divisor: float, unit_s: float, how: str) -> float:
     """CP-SAT's integer bound as a bound of W (weighted) or of model.py's lexicographic scalar."""
     if how != "lexicographic":
         return raw / divisor
     # Σk − M·S ≥ B with 0 ≤ Σk < M gives −S ≥ s0 = ⌈(B − M + 1)/M⌉ and, at −S = s0, Σk ≥ B − M·s0
     s0 = math.ceil((raw - per_flight + 1) / per_flight)
-    return s0 + unit_s * max(0.0, raw - per_flight * s0) / (float(np.sum(problem.delay_upper_s)) + 1.0)
+    return s0 + unit_s * max(0.0, raw - per_flight * s0) * problem.objective.per_delay
 
 
 def _solver(profile, options: dict, limit_s: float):
@@ -159,8 +162,8 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
     (:mod:`~uamopt.solvers.warmstart`), and never worse than it.
 
     Then (option ``continuous_bound``, default true) the ``inner`` model (cells of width u, a
-    relaxation) is solved, hinted with that solution, for the rest of the time limit (at least
-    1 s): its bound L is valid for continuous delays, so OPT ∈ [L, objective] and the summary gives
+    relaxation) is solved, hinted with that solution, for the rest of the time limit (skipped when
+    less than 0.5 s is left; the limit covers both models' building): its bound L is valid for continuous delays, so OPT ∈ [L, objective] and the summary gives
     ``continuous_bound`` = L and ``optimal_within`` = objective − L (an ε proved on this instance;
     no a-priori ε exists, since a feasible window narrower than u may hold no lattice point).
     """
@@ -170,12 +173,8 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
 
     from uamopt.solvers.warmstart import no_worse, reduced, warm_start
 
-    options = dict(profile.options)
-    unit_s = float(options.pop("time_unit_s", 0.01))
-    want_bound = bool(options.pop("continuous_bound", True))
-    if not (math.isfinite(unit_s) and unit_s > 0):
-        raise UamoptError(f"time_unit_s must be a positive number of seconds, got {unit_s}",
-                          f"profile {profile.name or 'cpsat'}", "use e.g. 0.01")
+    unit_s, want_bound = profile.option("time_unit_s"), profile.option("continuous_bound")
+    options = {k: v for k, v in profile.options.items() if k not in ("time_unit_s", "continuous_bound")}  # CP-SAT's own
     t0 = time.perf_counter()
     small = reduced(problem)  # dominance caps (warmstart.py): the same optima
     model, operate, delay, _, per_flight, divisor, how = build_cpsat(small, unit_s)
@@ -183,17 +182,20 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
     for f in range(problem.n_flights):
         model.add_hint(operate[f], bool(start.operated[f]))
         model.add_hint(delay[f], int(np.rint(start.delay_s[f] / unit_s)) if start.operated[f] else 0)
-    solver = _solver(profile, options, profile.time_limit_s)
+    build_s = time.perf_counter() - t0  # model, warm start and hints
+    solver = _solver(profile, options, max(0.05, profile.time_limit_s - build_s))  # the limit covers the build too
     with stopping(solver.stop_search):  # Ctrl-C and SIGTERM stop the search at once
         code = solver.solve(model)
-    seconds = float(solver.wall_time)
+    seconds = time.perf_counter() - t0
     n = problem.n_flights
     extras = {"termination": solver.status_name(code), "time_unit_s": unit_s, "objective_scale": how,
               "model": f"delay lattice {unit_s:g} s, constraints rounded outward (a restriction of the continuous model)",
-              "branches": int(solver.num_branches), "warm_start": f"{start.source} {start.objective:.6f}"}
+              "branches": int(solver.num_branches), "warm_start": f"{start.source} {start.objective:.6f}",
+              "build_seconds": build_s}
     if code == cp_model.MODEL_INVALID:
-        raise UamoptError(f"CP-SAT rejected the model: {model.validate()}", f"profile {profile.name or 'cpsat'}",
-                          "report this as a bug")
+        why = model.validate() or solver.solution_info()
+        raise UamoptError(f"CP-SAT rejected the run: {why}", f"profile {profile.name or 'cpsat'}",
+                          "check the profile's [options]" if not model.validate() else "report this as a bug")
     if code == cp_model.INFEASIBLE:
         return make_schedule(problem, "cpsat", "infeasible", np.zeros(n, bool), np.zeros(n), solve_seconds=seconds,
                              seed=profile.seed, extras=extras)
@@ -204,20 +206,20 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
     delay_k = [solver.value(v) for v in delay]
     delay_s = np.array(delay_k, dtype=float) * unit_s
     status = "optimal" if code == cp_model.OPTIMAL else "time_limit"  # FEASIBLE: stopped by the time limit
-    bound = _bound(problem, solver.best_objective_bound, per_flight, divisor, unit_s, how)
+    bound = objective_bound(problem, solver.best_objective_bound, per_flight, divisor, unit_s, how)
     schedule = no_worse(problem, make_schedule(problem, "cpsat", status, operated, delay_s, bound=bound,
                                                solve_seconds=seconds, seed=profile.seed, extras=extras), start)
-    if want_bound:
+    if want_bound and profile.time_limit_s - (time.perf_counter() - t0) > 0.5:
         inner, i_op, i_delay, _, i_flight, i_div, i_how = build_cpsat(small, unit_s, rounding="inner")
         for f in range(n):  # the outer solution is a point of the relaxation
             inner.add_hint(i_op[f], bool(operated[f]))
             inner.add_hint(i_delay[f], int(delay_k[f]))
-        left = max(1.0, profile.time_limit_s - (time.perf_counter() - t0))
+        left = max(0.05, profile.time_limit_s - (time.perf_counter() - t0))
         relaxed = _solver(profile, options, left)
         r_code = relaxed.solve(inner)
         if r_code in (cp_model.OPTIMAL, cp_model.FEASIBLE, cp_model.UNKNOWN):
-            low = _bound(problem, relaxed.best_objective_bound, i_flight, i_div, unit_s, i_how)
+            low = objective_bound(problem, relaxed.best_objective_bound, i_flight, i_div, unit_s, i_how)
             schedule.extras.update(continuous_bound=low, continuous_bound_termination=relaxed.status_name(r_code),
                                    continuous_bound_model=f"delay cells {unit_s:g} s (relaxation of the continuous model)",
                                    optimal_within=schedule.objective - low)
-    return schedule
+    return dataclasses.replace(schedule, solve_seconds=time.perf_counter() - t0)

@@ -57,9 +57,9 @@ from uamopt.solvers.greedy import (
     CANCEL,
     DEFAULT_STEP_S,
     EPS_S,
-    check_options,
     decoder_for,
 )
+from uamopt.solvers.options import refuse_unknown
 
 
 @dataclass(frozen=True)
@@ -85,7 +85,7 @@ class GeneticOptions:
     def from_options(cls, options: dict, solver: str) -> GeneticOptions:
         """Validated options (one-line errors naming the option and its range)."""
         names = {f.name: f.type for f in fields(cls)}
-        check_options(options, set(names), solver)
+        refuse_unknown(options, set(names), solver)
         kw = {}
         for key, value in options.items():
             kind = {"int": int, "float": float, "bool": bool}[str(names[key])]
@@ -106,13 +106,15 @@ class GeneticOptions:
 
 
 def objective_values(problem: SchedulingProblem, operated: np.ndarray, delay_s: np.ndarray) -> np.ndarray:
-    """W of each row (Eqs. 20-22, or the lexicographic scalar): ``evaluate`` over a population."""
-    total = np.sum(np.where(operated, delay_s, 0.0), axis=1)
-    flights = np.sum(operated, axis=1)
-    if problem.objective_kind == "lexicographic":
-        return -flights + total / (float(np.sum(problem.delay_upper_s)) + 1.0)
-    w6, w7 = problem.weights
-    return w6 * total / problem.aircraft_count - w7 * flights
+    """W of each row (Eqs. 20-22, or the lexicographic scalar; ``problem.objective``) plus, for each
+    must-operate flight cancelled, a penalty above the whole range of W (so any such row is worse
+    than every feasible one)."""
+    obj = problem.objective
+    w = obj.values(operated, delay_s)
+    if not problem.must_operate.any():
+        return w
+    penalty = obj.per_flight * problem.n_flights + obj.per_delay * float(np.sum(problem.delay_upper_s)) + 1.0
+    return w + penalty * np.sum(problem.must_operate & ~np.asarray(operated, dtype=bool), axis=-1)
 
 
 def fitness(w: np.ndarray) -> np.ndarray:
@@ -277,5 +279,7 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
               "greedy_objective": float(w[0]), "history": best.history}
     if profile.solver == "soa":
         extras["final_temperature"] = opts.t0 * opts.xi ** max(generations - 1, 0)
-    return make_schedule(problem, profile.solver, "time_limit" if timed_out else "feasible", best.operated, best.delay,
+    status = ("infeasible" if np.any(problem.must_operate & ~best.operated)
+              else "time_limit" if timed_out else "feasible")
+    return make_schedule(problem, profile.solver, status, best.operated, best.delay,
                          solve_seconds=time.perf_counter() - start, seed=profile.seed, extras=extras)

@@ -3,15 +3,16 @@
 Preliminary strategy
 --------------------
 Flights are taken in the conflict-resolution order f' = order of planned departure D (ties: flight
-index). Flight f is checked against every flight placed before it (Fig. 11): its departure starts
+index); flights that must operate (``problem.must_operate``, none in the paper's model) come first. Flight f is checked against every flight placed before it (Fig. 11): its departure starts
 at the earliest admissible time, max(D_f, arrival + ΔT of its aircraft's previous *operated* flight)
 (Eqs. 27-28), and while it conflicts with an already placed operated flight — dep_f lies in one of
-that pair's forbidden open intervals (``SchedulingProblem.conflict_arrays``, the 3×3×3 zone of
+that pair's forbidden open intervals (``problem.pairs``, uamopt.schedule.core; the 3×3×3 zone of
 Fig. 13) — it is delayed past the interval's end (Fig. 12). Delays are whole multiples of
 ΔT_a (``step_s``, Table B.3: 10 s), so a delay is rounded *up* to the step; with ``exact_gaps``
 the flight goes exactly to the gap's end instead. When the delay needed exceeds the flight's
 threshold, min(Δd_f, T_f − A_f) (Eqs. 26, 29), the flight is cancelled; a cancelled outbound
-cancels its return (docs/readings.md: the aircraft never left). The result is feasible by construction.
+cancels its return (docs/readings.md: the aircraft never left). The result is feasible by construction,
+except that a must-operate flight that cannot be placed is cancelled too (status ``infeasible``).
 
 Decoder (shared with :mod:`uamopt.solvers.genetic`)
 ---------------------------------------------------
@@ -62,14 +63,13 @@ class Decoder:
     def from_problem(cls, problem: SchedulingProblem, order: np.ndarray | None = None) -> Decoder:
         n = problem.n_flights
         if order is None:
-            order = np.lexsort((np.arange(n), problem.planned_departure_s))
+            order = np.lexsort((np.arange(n), problem.planned_departure_s, ~problem.must_operate))
         order = np.asarray(order, dtype=np.int64)
         pos = np.empty(n, dtype=np.int64)
         pos[order] = np.arange(n)
-        pairs, ptr, intervals = problem.conflict_arrays
-        row_pair = np.repeat(np.arange(len(pairs)), np.diff(ptr))
-        p, q = pairs[row_pair, 0], pairs[row_pair, 1]
-        lo, hi = intervals[:, 0], intervals[:, 1]
+        view = problem.pairs
+        p, q = view.p[view.row_pair], view.q[view.row_pair]
+        lo, hi = view.lo, view.hi
         dep0 = problem.planned_departure_s
         q_later = pos[q] > pos[p]
         # q placed after p: dep_q ∈ (dep_p + lo, dep_p + hi); p after q: dep_p ∈ (dep_q − hi, dep_q − lo)
@@ -105,7 +105,7 @@ class Decoder:
         size, n = genes.shape
         dep0, upper = problem.planned_departure_s, problem.delay_upper_s
         free_after = problem.flight_time_s + problem.turnaround_after_s  # dep_e + this ≤ next dep (Eq. 27)
-        aircraft, requires = problem.flights.aircraft_index, problem.requires
+        aircraft, requires, must = problem.flights.aircraft_index, problem.requires, problem.must_operate
         operated = np.zeros((size, n), dtype=bool)
         dep = np.zeros((size, n))
         delay = np.zeros((size, n))
@@ -117,7 +117,7 @@ class Decoder:
         for i, f in enumerate(self.order):
             g, cap = aircraft[f], upper[f] + EPS_S
             want = genes[:, f]
-            on = want != CANCEL
+            on = (want != CANCEL) | must[f]
             if requires[f] >= 0:
                 on &= operated[:, requires[f]]  # a cancelled outbound cancels its return
             d = snap(np.maximum(np.maximum(want, 0) * step_s, ready[:, g] - dep0[f]))
@@ -153,22 +153,6 @@ def decoder_for(problem: SchedulingProblem) -> Decoder:
     return decoder
 
 
-def decoder_options(options: dict, solver: str, default_step_s: float = DEFAULT_STEP_S) -> tuple[float, bool]:
-    """``step_s`` and ``exact_gaps`` of a profile's options, validated (ΔT_a > 0); ``step_s``
-    defaults to the problem's ΔT_a (``schedule.time_step_s``)."""
-    step_s = float(options.get("step_s", default_step_s))
-    if not step_s > 0:
-        raise UamoptError(f"step_s must be positive, got {step_s}", f"solver {solver}", "give ΔT_a in seconds, e.g. 10")
-    return step_s, bool(options.get("exact_gaps", False))
-
-
-def check_options(options: dict, known: set[str], solver: str) -> None:
-    """Raise on an option the solver does not know (scikit-learn style: validate at the boundary)."""
-    unknown = sorted(set(options) - known)
-    if unknown:
-        raise UamoptError(f"unknown option '{unknown[0]}'", f"solver {solver}", f"valid options are {', '.join(sorted(known))}")
-
-
 def greedy_decisions(problem: SchedulingProblem, step_s: float | None = None, exact_gaps: bool = False
                      ) -> tuple[np.ndarray, np.ndarray]:
     """Operated flags and delays (s) of the preliminary strategy (Sec. 5.2.1); ``step_s``
@@ -179,10 +163,11 @@ def greedy_decisions(problem: SchedulingProblem, step_s: float | None = None, ex
 
 
 def solve(problem: SchedulingProblem, profile) -> Schedule:
-    """The preliminary strategy as a solver: status "feasible", no bound."""
-    check_options(profile.options, {"step_s", "exact_gaps"}, "greedy")
-    step_s, exact = decoder_options(profile.options, "greedy", problem.time_step_s)
+    """The preliminary strategy as a solver: status "feasible" (``infeasible`` when a must-operate
+    flight cannot be placed), no bound."""
+    step_s, exact = profile.option("step_s", problem.time_step_s), profile.option("exact_gaps")
     start = time.perf_counter()
     operated, delay = greedy_decisions(problem, step_s, exact)
-    return make_schedule(problem, "greedy", "feasible", operated, delay, solve_seconds=time.perf_counter() - start,
+    status = "infeasible" if np.any(problem.must_operate & ~operated) else "feasible"
+    return make_schedule(problem, "greedy", status, operated, delay, solve_seconds=time.perf_counter() - start,
                          seed=profile.seed, extras={"step_s": step_s, "exact_gaps": exact})

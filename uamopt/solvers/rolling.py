@@ -11,11 +11,9 @@ on a **sub-problem** in which the flights of earlier windows are *fixed* at thei
   of ``problem.conflicts``), or it is the last operated earlier flight of a free flight's aircraft
   (the turnaround rule of the model is implied by the last operated one) — enters the sub-problem
   as a *fixed* flight: planned departure = its decided departure, delay bound 0 (``max_delay_s
-  = 0``), and it **must operate**. The model has no "must operate" notion, so it is added by a
-  small extension of the inner model built here: ``operate[i] == 1`` in the CP-SAT model of
-  :func:`uamopt.solvers.cpsat.build_cpsat`, ``m.operate[i].fix(1)`` in the Pyomo model of
-  :func:`uamopt.solvers.milp.build_model`. (Including them with delay bound 0 only and
-  post-checking would let the solver buy free flights by cancelling a fixed one.) Conflict
+  = 0``), and it **must operate** (``must_operate`` of the sub-problem, uamopt.schedule.core,
+  which every inner solver reads; with delay bound 0 only, the solver could buy free flights by
+  cancelling a fixed one). Conflict
   intervals are on actual departures, so they carry over unchanged; fixed–fixed pairs are
   dropped (already satisfied);
 - a free return whose outbound was cancelled in an earlier window is cancelled (precedence);
@@ -44,6 +42,10 @@ M is a greedy maximum-improvement matching; dist is reduced by 2·TIME_TOL_S to 
 the feasibility tolerance. Lexicographic: the same with −1 per flight and dist/(ΣU + 1).
 (The sum of the windows' own bounds is *not* a bound of the whole problem.)
 
+Time: ``time_limit_s`` bounds the whole solve; each window's inner solve gets at most what is left
+of it, and the windows reached after it are placed together by the greedy strategy, earlier
+decisions fixed (``extras["windows_past_limit"]``).
+
 Options (``[options]`` of a profile): ``window_s`` (900), ``inner`` ("cpsat"), ``window_time_limit_s``
 (default ``time_limit_s`` / number of non-empty windows), ``time_unit_s`` (CP-SAT, 0.01),
 ``step_s`` (greedy fallback ΔT_a; default the problem's ``schedule.time_step_s``). Status: ``feasible``, or
@@ -65,31 +67,27 @@ from uamopt.interrupts import stopping
 from uamopt.schedule.flights import TIME_TOL_S
 from uamopt.schedule.model import Schedule, SchedulingProblem, make_schedule, violations
 from uamopt.schedule.occupancy import ConflictTable
-from uamopt.solvers.greedy import Decoder, check_options, greedy_decisions
+from uamopt.solvers.greedy import greedy_decisions
 
-KNOWN = {"window_s", "inner", "window_time_limit_s", "time_unit_s", "step_s"}
 
 
 # --- the cheap lower bound ---------------------------------------------------------------------
 def pair_matching_bound(problem: SchedulingProblem) -> float:
     """A valid lower bound of the optimum (module docstring): disjoint conflicting pairs, each alone."""
     n = problem.n_flights
-    pairs, ptr, intervals = problem.conflict_arrays
-    lexi = problem.objective_kind == "lexicographic"
-    per_flight = 1.0 if lexi else float(problem.weights[1])
-    per_delay = 1.0 / (float(np.sum(problem.delay_upper_s)) + 1.0) if lexi else float(problem.weights[0]) / problem.aircraft_count
-    if len(pairs) == 0:
+    view = problem.pairs
+    per_flight, per_delay = problem.objective.per_flight, problem.objective.per_delay
+    if len(view) == 0:
         return -per_flight * n
-    dep, upper = problem.planned_departure_s, problem.delay_upper_s
-    p, q = pairs[:, 0], pairs[:, 1]
-    delta0 = dep[q] - dep[p]
-    row_pair = np.repeat(np.arange(len(pairs)), np.diff(ptr))
-    lo, hi = intervals[:, 0], intervals[:, 1]
-    d0 = delta0[row_pair]
+    upper = problem.delay_upper_s
+    p, q = view.p, view.q
+    row_pair = view.row_pair
+    lo, hi = view.lo, view.hi
+    d0 = view.shift[row_pair]
     inside = (lo < d0) & (d0 < hi)
     down = np.where(lo >= d0 - upper[p[row_pair]], d0 - lo, np.inf)  # p delayed / q earlier: δ down to lo
     up = np.where(hi <= d0 + upper[q[row_pair]], hi - d0, np.inf)  # q delayed: δ up to hi
-    dist = np.zeros(len(pairs))
+    dist = np.zeros(len(view))
     rows = np.flatnonzero(inside)
     dist[row_pair[rows]] = np.minimum(down[rows], up[rows])
     dist = np.maximum(0.0, dist - 2 * TIME_TOL_S)
@@ -150,27 +148,17 @@ def subproblem(problem: SchedulingProblem, free: np.ndarray, fixed: np.ndarray, 
                           intervals=c.intervals[row_keep])
     sub = SchedulingProblem(flights=sub_fs, conflicts=table, weights=problem.weights,
                             aircraft_count=problem.aircraft_count, objective_kind=problem.objective_kind,
-                            time_step_s=problem.time_step_s)
+                            time_step_s=problem.time_step_s, must_operate=is_fixed[index] | problem.must_operate[index])
     return sub, index, is_fixed[index]
 
 
-def _greedy_fixed_first(sub: SchedulingProblem, fixed: np.ndarray, step_s: float) -> tuple[np.ndarray, np.ndarray]:
-    """The preliminary strategy with the fixed flights placed first (by departure), then the free ones."""
-    dep = sub.planned_departure_s
-    order = np.lexsort((np.arange(sub.n_flights), dep, ~fixed))
-    operated, delay = Decoder.from_problem(sub, order).decode(sub, np.zeros(sub.n_flights, dtype=np.int64), step_s)
-    return operated[0], delay[0]
-
-
-def _inner_cpsat(sub: SchedulingProblem, fixed: np.ndarray, hint: tuple[np.ndarray, np.ndarray], limit_s: float,
+def _inner_cpsat(sub: SchedulingProblem, hint: tuple[np.ndarray, np.ndarray], limit_s: float,
                  threads: int, seed: int, unit_s: float) -> tuple[np.ndarray, np.ndarray, bool] | None:
     from ortools.sat.python import cp_model
 
     from uamopt.solvers.cpsat import build_cpsat
 
-    model, operate, delay, *_ = build_cpsat(sub, unit_s)
-    for i in np.flatnonzero(fixed).tolist():
-        model.add(operate[i] == 1)  # the "must operate" extension
+    model, operate, delay, *_ = build_cpsat(sub, unit_s)  # the fixed flights must operate (sub.must_operate)
     h_op, h_d = hint
     for i in range(sub.n_flights):
         model.add_hint(operate[i], bool(h_op[i]))
@@ -193,7 +181,7 @@ def _inner_cpsat(sub: SchedulingProblem, fixed: np.ndarray, hint: tuple[np.ndarr
     return operated, delay_s, code == cp_model.OPTIMAL
 
 
-def _inner_highs(sub: SchedulingProblem, fixed: np.ndarray, limit_s: float, threads: int, seed: int
+def _inner_highs(sub: SchedulingProblem, limit_s: float, threads: int, seed: int
                  ) -> tuple[np.ndarray, np.ndarray, bool] | None:
     import pyomo.environ as pyo
     from pyomo.contrib.solver.common.factory import SolverFactory
@@ -201,9 +189,7 @@ def _inner_highs(sub: SchedulingProblem, fixed: np.ndarray, limit_s: float, thre
 
     from uamopt.solvers import milp
 
-    m = milp.build_model(sub)
-    for i in np.flatnonzero(fixed).tolist():
-        m.operate[i].fix(1)  # the "must operate" extension
+    m = milp.build_model(sub)  # the fixed flights must operate (sub.must_operate)
     solver = SolverFactory(milp.SOLVER_NAME)
     with stopping(milp.cancel(solver)):
         result = solver.solve(m, time_limit=float(limit_s), threads=int(threads),
@@ -222,16 +208,8 @@ def _inner_highs(sub: SchedulingProblem, fixed: np.ndarray, limit_s: float, thre
 
 # --- the solver -----------------------------------------------------------------------------------
 def _options(profile) -> dict:
-    check_options(profile.options, KNOWN, "rolling")
-    o = dict(profile.options)
-    inner = str(o.get("inner", "cpsat"))
-    if inner not in ("cpsat", "highs"):
-        raise UamoptError(f"unknown inner solver '{inner}'", "solver rolling", "use inner = \"cpsat\" or \"highs\"")
-    window = float(o.get("window_s", 900.0))
-    if not (math.isfinite(window) and window > 0):
-        raise UamoptError(f"window_s must be positive, got {window}", "solver rolling", "give a window in seconds, e.g. 900")
-    return {"inner": inner, "window_s": window, "window_time_limit_s": o.get("window_time_limit_s"),
-            "time_unit_s": float(o.get("time_unit_s", 0.01)), "step_s": o.get("step_s")}
+    """The profile's options (typed and checked by the profile, uamopt.solvers.options), defaults filled."""
+    return {key: profile.option(key) for key in ("inner", "window_s", "window_time_limit_s", "time_unit_s", "step_s")}
 
 
 def solve(problem: SchedulingProblem, profile) -> Schedule:
@@ -242,6 +220,7 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
 
     o = _options(profile)
     start = time.perf_counter()
+    deadline = start + profile.time_limit_s
     first = warm_start(problem, o["step_s"], seed=profile.seed)
     n = problem.n_flights
     dep0 = problem.planned_departure_s
@@ -251,14 +230,19 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
     windows = [order[window_of[order] == w] for w in np.unique(window_of)]
     limit = float(o["window_time_limit_s"]) if o["window_time_limit_s"] is not None else profile.time_limit_s / max(len(windows), 1)
     aircraft = problem.flights.aircraft_index
-    pairs = problem.conflict_arrays[0]
+    pairs = np.stack([problem.pairs.p, problem.pairs.q], axis=1)
     decided = np.zeros(n, dtype=bool)
     operated = np.zeros(n, dtype=bool)
     delay = np.zeros(n)
     last_operated = np.full(problem.flights.n_aircraft, -1, dtype=np.int64)
     stats = {"windows": len(windows), "window_time_limit_s": limit, "inner": o["inner"], "proved": 0,
              "unproved": 0, "greedy_windows": 0, "cancelled_windows": 0, "max_subproblem": 0}
-    for free in windows:
+    w = 0
+    while w < len(windows):
+        free, w = windows[w], w + 1
+        if deadline - time.perf_counter() < 0.05 and w < len(windows):  # past the limit: the rest in one greedy pass
+            stats["windows_past_limit"] = 1 + len(windows) - w
+            free, w = np.concatenate([free, *windows[w:]]), len(windows)
         free = np.sort(free)
         # a return whose outbound was cancelled earlier cannot fly
         req = problem.requires[free]
@@ -276,23 +260,26 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
         fixed = fixed[fixed >= 0].astype(np.int64)
         sub, index, fixed_mask = subproblem(problem, free, fixed, dep0 + delay)
         stats["max_subproblem"] = max(stats["max_subproblem"], sub.n_flights)
-        hint = _greedy_fixed_first(sub, fixed_mask, float(o["step_s"] or problem.time_step_s))
+        hint = greedy_decisions(sub, float(o["step_s"] or problem.time_step_s))  # must-operate flights placed first
         answer = None
+        left = deadline - time.perf_counter()
         try:
-            if o["inner"] == "cpsat":
-                answer = _inner_cpsat(sub, fixed_mask, hint, limit, profile.threads, profile.seed, o["time_unit_s"])
+            if left < 0.05:  # the whole-solve limit is spent: the greedy hint
+                pass
+            elif o["inner"] == "cpsat":
+                answer = _inner_cpsat(sub, hint, min(limit, left), profile.threads, profile.seed, o["time_unit_s"])
             else:
-                answer = _inner_highs(sub, fixed_mask, limit, profile.threads, profile.seed)
+                answer = _inner_highs(sub, min(limit, left), profile.threads, profile.seed)
         except UamoptError:
             answer = None
-        ok = answer is not None and bool(np.all(answer[0][fixed_mask])) and not violations(sub, answer[0], answer[1])
+        ok = answer is not None and not violations(sub, answer[0], answer[1])  # violations checks must-operate
         if ok:
             stats["proved" if answer[2] else "unproved"] += 1
             sub_op, sub_d = answer[0], answer[1]
         else:
             stats["greedy_windows"] += 1
             sub_op, sub_d = hint
-            if not np.all(sub_op[fixed_mask]) or violations(sub, sub_op, sub_d):
+            if violations(sub, sub_op, sub_d):
                 stats["cancelled_windows"] += 1
                 sub_op, sub_d = fixed_mask.copy(), np.zeros(sub.n_flights)
         free_rows = ~fixed_mask

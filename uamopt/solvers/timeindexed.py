@@ -11,7 +11,7 @@ Binary x_{f,k} = 1: flight f operates with delay index k ∈ {0, …, K_f}, K_f 
   (a union of integer intervals): for every a, x_{p,a} + Σ_{b ∈ a + Z} x_{q,b} ≤ 1 — the
   *aggregated* conflict inequality, exact for 0-1 points because Σ_b x_{q,b} ≤ 1, and far tighter
   in the LP than big-M rows. Pairs are (i) every conflicting pair of ``problem.conflicts`` (its
-  forbidden open intervals (lo, hi) of δ = dep_q − dep_p, read from ``conflict_arrays``) and
+  forbidden open intervals (lo, hi) of δ = dep_q − dep_p, read from ``problem.pairs``) and
   (ii) every ordered pair e before f of one aircraft (turnaround, Eqs. 27-28: dep_f − dep_e ≥
   A_ef = T_e + ΔT_e with both operated; the all-pairs form is exact, model.py);
 - objective     Σ_{f,k} (w_d · k s − w_c) x_{f,k}: Eq. 20 (w_d = ω6/G, w_c = ω7) or the
@@ -61,7 +61,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -69,10 +69,9 @@ from uamopt.errors import UamoptError
 from uamopt.interrupts import stopping
 from uamopt.schedule.flights import TIME_TOL_S
 from uamopt.schedule.model import Schedule, SchedulingProblem, make_schedule
-from uamopt.solvers.greedy import check_options
+from uamopt.solvers.deadline import highs_can_start, interrupt_at, quiet_highs
 from uamopt.solvers.warmstart import Start, no_worse, reduced, warm_start
 
-KNOWN = {"step_s", "model", "engine", "warm_soa_s", "continuous_bound_s", "continuous_bound_step_s", "mip_rel_gap"}
 ETA_S = 1e-9  # float round-off accepted when rounding a time to grid steps, s
 AUTO_HIGHS_COLUMNS = 8000  # engine "auto": HiGHS up to this many columns, "hybrid" above
 HYBRID_HIGHS_SHARE = 0.3  # engine "hybrid": this share of the time to HiGHS (no presolve), the rest to CP-SAT
@@ -89,6 +88,7 @@ class GridModel:
     row_ptr: np.ndarray  # pair and assignment rows (all "≤ 1", coefficients 1): CSR
     row_col: np.ndarray
     prec: np.ndarray  # (m, 2): (f, r) with Σ x_f ≤ Σ x_r
+    must: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))  # flights with Σ x_f = 1 (core.py)
 
     @property
     def n_cols(self) -> int:
@@ -96,7 +96,7 @@ class GridModel:
 
     @property
     def n_rows(self) -> int:
-        return len(self.row_ptr) - 1 + len(self.prec)
+        return len(self.row_ptr) - 1 + len(self.prec) + len(self.must)
 
     def columns_of(self, operated: np.ndarray, delay_s: np.ndarray) -> np.ndarray | None:
         """The 0-1 vector of a schedule whose delays are on the grid, or None if one is not."""
@@ -123,11 +123,9 @@ def _forbidden_steps(problem: SchedulingProblem, step_s: float, kind: str, k_max
     """(p, q, z_lo, z_hi): the integer intervals of forbidden z = k_q − k_p, conflicts then turnarounds."""
     eta = ETA_S / step_s
     dep, s = problem.planned_departure_s, step_s
-    pairs, ptr, intervals = problem.conflict_arrays
-    row_pair = np.repeat(np.arange(len(pairs)), np.diff(ptr))
-    p, q = pairs[row_pair, 0], pairs[row_pair, 1]
-    shift = dep[q] - dep[p]
-    lo, hi = intervals[:, 0] - shift, intervals[:, 1] - shift
+    view = problem.pairs  # forbidden intervals of δ, less the pair's shift: of z = d_q − d_p (core.py)
+    p, q = view.p[view.row_pair], view.q[view.row_pair]
+    lo, hi = view.lo - view.shift[view.row_pair], view.hi - view.shift[view.row_pair]
     if kind == "grid":
         z_lo, z_hi = np.floor(lo / s + eta) + 1, np.ceil(hi / s - eta) - 1
     else:
@@ -167,11 +165,7 @@ def build_grid_model(problem: SchedulingProblem, step_s: float = 10.0, kind: str
     start = np.concatenate([[0], np.cumsum(k_max + 1)]).astype(np.int64)
     flight_of_col = np.repeat(np.arange(n), k_max + 1)
     k_of_col = np.arange(start[-1]) - start[flight_of_col]
-    if problem.objective_kind == "lexicographic":
-        per_delay, per_flight = 1.0 / (float(np.sum(problem.delay_upper_s)) + 1.0), 1.0
-    else:
-        per_delay, per_flight = problem.weights[0] / problem.aircraft_count, float(problem.weights[1])
-    cost = per_delay * k_of_col * step_s - per_flight
+    cost = problem.objective.per_delay * k_of_col * step_s - problem.objective.per_flight
     p, q, z_lo, z_hi = _forbidden_steps(problem, step_s, kind, k_max)
     if both_ways:
         p, q, z_lo, z_hi = np.concatenate([p, q]), np.concatenate([q, p]), np.concatenate([z_lo, -z_hi]), np.concatenate([z_hi, -z_lo])
@@ -203,7 +197,8 @@ def build_grid_model(problem: SchedulingProblem, step_s: float = 10.0, kind: str
     row_col = np.concatenate([assign_cols, col]).astype(np.int64)
     req = problem.requires
     prec = np.stack([np.flatnonzero(req >= 0), req[req >= 0]], axis=1).astype(np.int64)
-    return GridModel(step_s=float(step_s), kind=kind, start=start, cost=cost, row_ptr=row_ptr, row_col=row_col, prec=prec)
+    return GridModel(step_s=float(step_s), kind=kind, start=start, cost=cost, row_ptr=row_ptr, row_col=row_col, prec=prec,
+                     must=np.flatnonzero(problem.must_operate).astype(np.int64))
 
 
 def model_name(kind: str, step_s: float) -> str:
@@ -225,14 +220,18 @@ class EngineResult:
     best_incumbent_s: float | None = None
 
 
-def _highs(model: GridModel, limit_s: float, threads: int, seed: int, gap: float, hint: np.ndarray | None,
+def _left(deadline: float) -> float:
+    """Seconds to ``deadline`` (a ``time.perf_counter`` time), at least 0.05."""
+    return max(0.05, deadline - time.perf_counter())
+
+
+def _highs(model: GridModel, deadline: float, threads: int, seed: int, gap: float, hint: np.ndarray | None,
            presolve: bool = True) -> EngineResult:
     import highspy
 
-    h = highspy.Highs()
+    h = quiet_highs()
     h.resetGlobalScheduler(True)  # HiGHS keeps one thread pool per process: a new thread count needs a new pool
     h.setOptionValue("output_flag", False)
-    h.setOptionValue("time_limit", float(limit_s))
     h.setOptionValue("threads", int(threads))
     h.setOptionValue("random_seed", int(seed))
     h.setOptionValue("mip_rel_gap", float(gap))
@@ -255,8 +254,15 @@ def _highs(model: GridModel, limit_s: float, threads: int, seed: int, gap: float
         k = len(model.prec)
         h.addRows(k, np.full(k, -inf), np.zeros(k), len(cols), np.array(ptr[:-1], dtype=np.int32),
                   np.array(cols, dtype=np.int32), np.array(vals))
+    if len(model.must):  # Σ_k x_{f,k} ≥ 1: must operate
+        spans = [np.arange(model.start[f], model.start[f + 1]) for f in model.must.tolist()]
+        ptr = np.concatenate([[0], np.cumsum([len(c) for c in spans])[:-1]]).astype(np.int32)
+        cols = np.concatenate(spans).astype(np.int32)
+        h.addRows(len(spans), np.ones(len(spans)), np.full(len(spans), inf), len(cols), ptr, cols, np.ones(len(cols)))
     if hint is not None:
         h.setSolution(_solution(highspy, hint))
+    h.setOptionValue("time_limit", _left(deadline))  # what the model's loading left of the limit
+    interrupt_at(h, deadline)  # HiGHS's own limit is not checked everywhere (deadline.py)
     t0 = time.perf_counter()
     found: list[float] = []  # times of HiGHS's improving solutions
     h.cbMipImprovingSolution.subscribe(lambda *_: found.append(time.perf_counter() - t0))
@@ -271,7 +277,7 @@ def _highs(model: GridModel, limit_s: float, threads: int, seed: int, gap: float
     x = np.array(sol.col_value) if sol.value_valid else None
     if hint is not None and x is not None and abs(float(model.cost @ x) - info.objective_function_value) > 1e-6 * (
             1.0 + abs(info.objective_function_value)):  # a solution that is not the one reported: trust neither
-        return _highs(model, limit_s, threads, seed, gap, None, presolve)
+        return _highs(model, deadline, threads, seed, gap, None, presolve)
     proved = status == highspy.HighsModelStatus.kOptimal
     bound = float(info.mip_dual_bound) if math.isfinite(info.mip_dual_bound) else None
     if proved and x is not None:
@@ -287,20 +293,25 @@ def _solution(highspy, x: np.ndarray):
     return sol
 
 
-def _cpsat(model: GridModel, problem: SchedulingProblem, limit_s: float, threads: int, seed: int, gap: float,
+def _cpsat(model: GridModel, problem: SchedulingProblem, deadline: float, threads: int, seed: int, gap: float,
            hint: np.ndarray | None) -> EngineResult:
     from ortools.sat.python import cp_model
 
-    from uamopt.solvers.cpsat import _bound, _objective
+    from uamopt.solvers.cpsat import integer_objective, objective_bound
 
     k_max = np.diff(model.start) - 1
-    per_unit, per_flight, divisor, how = _objective(problem, model.step_s, k_max)
+    per_unit, per_flight, divisor, how = integer_objective(problem, model.step_s, k_max)
     m = cp_model.CpModel()
     x = [m.new_bool_var(f"x{j}") for j in range(model.n_cols)]
     for r in range(len(model.row_ptr) - 1):
         m.add_at_most_one([x[j] for j in model.row_col[model.row_ptr[r]:model.row_ptr[r + 1]].tolist()])
+        if r % 20000 == 19999 and time.perf_counter() > deadline:  # the limit ran out while loading the model
+            return EngineResult(x=None, bound=None, proved=False, termination="not run (the limit ran out building)",
+                                seconds=0.0)
     for f, r in model.prec.tolist():
         m.add(sum(x[model.start[f]:model.start[f + 1]]) <= sum(x[model.start[r]:model.start[r + 1]]))
+    for f in model.must.tolist():
+        m.add_exactly_one(x[model.start[f]:model.start[f + 1]])
     k_of_col = np.arange(model.n_cols) - np.repeat(model.start[:-1], k_max + 1)
     coef = (per_unit * k_of_col - per_flight).astype(np.int64).tolist()
     m.minimize(cp_model.LinearExpr.weighted_sum(x, coef))
@@ -308,7 +319,7 @@ def _cpsat(model: GridModel, problem: SchedulingProblem, limit_s: float, threads
         for j in range(model.n_cols):
             m.add_hint(x[j], bool(hint[j] > 0.5))
     solver = cp_model.CpSolver()
-    solver.parameters.max_time_in_seconds = float(limit_s)
+    solver.parameters.max_time_in_seconds = _left(deadline)
     solver.parameters.num_workers = int(threads)
     solver.parameters.random_seed = int(seed)
     solver.parameters.relative_gap_limit = float(gap)
@@ -323,7 +334,7 @@ def _cpsat(model: GridModel, problem: SchedulingProblem, limit_s: float, threads
         code = solver.solve(m, _Times())
     has = code in (cp_model.OPTIMAL, cp_model.FEASIBLE)
     values = np.array([solver.boolean_value(v) for v in x], dtype=float) if has else None
-    bound = _bound(problem, solver.best_objective_bound, per_flight, divisor, model.step_s, how)
+    bound = objective_bound(problem, solver.best_objective_bound, per_flight, divisor, model.step_s, how)
     return EngineResult(x=values, bound=bound, proved=code == cp_model.OPTIMAL, termination=solver.status_name(code),
                         seconds=float(solver.wall_time), first_incumbent_s=found[0] if found else None,
                         best_incumbent_s=found[-1] if found else None)
@@ -331,17 +342,24 @@ def _cpsat(model: GridModel, problem: SchedulingProblem, limit_s: float, threads
 
 def run_engine(engine: str, model: GridModel, problem: SchedulingProblem, limit_s: float, threads: int, seed: int,
                gap: float = 0.0, hint: np.ndarray | None = None) -> EngineResult:
-    """Solve a :class:`GridModel` with HiGHS or CP-SAT."""
+    """Solve a :class:`GridModel` with HiGHS or CP-SAT within ``limit_s`` seconds, loading the model
+    into the solver included."""
+    deadline = time.perf_counter() + limit_s
+    if engine == "highs" and not highs_can_start(model.n_rows, limit_s):
+        return EngineResult(x=None, bound=None, proved=False, seconds=0.0,
+                            termination="not run (HiGHS could not start within the limit: deadline.py)")
     if engine == "highs":
-        return _highs(model, limit_s, threads, seed, gap, hint)
+        return _highs(model, deadline, threads, seed, gap, hint)
     if engine == "cpsat":
-        return _cpsat(model, problem, limit_s, threads, seed, gap, hint)
+        return _cpsat(model, problem, deadline, threads, seed, gap, hint)
+    if engine == "hybrid" and not highs_can_start(model.n_rows, HYBRID_HIGHS_SHARE * limit_s, presolve=False):
+        return _cpsat(model, problem, deadline, threads, seed, gap, hint)  # HiGHS could not even start in its share
     if engine == "hybrid":  # HiGHS without presolve for incumbents, then CP-SAT from its best for the bound
-        first = _highs(model, HYBRID_HIGHS_SHARE * limit_s, threads, seed, gap, hint, presolve=False)
+        first = _highs(model, time.perf_counter() + HYBRID_HIGHS_SHARE * limit_s, threads, seed, gap, hint, presolve=False)
         if first.proved:
             return first
         start = first.x if first.x is not None else hint
-        second = _cpsat(model, problem, (1 - HYBRID_HIGHS_SHARE) * limit_s, threads, seed, gap, start)
+        second = _cpsat(model, problem, deadline, threads, seed, gap, start)
         xs = [r.x for r in (first, second) if r.x is not None]
         x = min(xs, key=lambda v: float(model.cost @ v)) if xs else None
         bounds = [b for b in (first.bound, second.bound) if b is not None]  # both bound the same model
@@ -356,15 +374,10 @@ def run_engine(engine: str, model: GridModel, problem: SchedulingProblem, limit_
 # --- the solver ------------------------------------------------------------------------------------
 def solve(problem: SchedulingProblem, profile) -> Schedule:
     """Build the time-indexed model, warm-start it, solve it; see the module docstring."""
-    check_options(profile.options, KNOWN, "timeindexed")
-    o = profile.options
-    step = float(o.get("step_s", 10.0))
-    kind = str(o.get("model", "grid"))
-    engine = str(o.get("engine", "auto"))
-    gap = float(o.get("mip_rel_gap", 0.0))
-    cont_s = float(o.get("continuous_bound_s", 0.0))
+    o = profile.option  # typed and checked by the profile (uamopt.solvers.options)
+    step, kind, engine, gap, cont_s = (o(k) for k in ("step_s", "model", "engine", "mip_rel_gap", "continuous_bound_s"))
     t0 = time.perf_counter()
-    start: Start = warm_start(problem, step, soa_s=float(o.get("warm_soa_s", 0.0)), seed=profile.seed, on_grid=True)
+    start: Start = warm_start(problem, step, soa_s=o("warm_soa_s"), seed=profile.seed, on_grid=True)
     small = reduced(problem)  # dominance caps: the same optima (warmstart.py)
     if engine == "auto":  # measured (docs/exact_scheduling.md): HiGHS proves ≤ 600 flights, CP-SAT gets further beyond
         engine = "highs" if int(np.sum(np.floor(small.delay_upper_s / step) + 1)) <= AUTO_HIGHS_COLUMNS else "hybrid"
@@ -392,7 +405,7 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
                              solve_seconds=time.perf_counter() - t0, seed=profile.seed, extras=extras)
     schedule = no_worse(problem, schedule, start)
     if cont_s > 0:
-        c_step = float(o.get("continuous_bound_step_s", step))
+        c_step = o("continuous_bound_step_s", step)
         relaxed = build_grid_model(reduced(problem), c_step, "relaxed")
         left = max(0.1, profile.time_limit_s - (time.perf_counter() - t0))
         r = run_engine(engine, relaxed, problem, left, profile.threads, profile.seed, gap, None)

@@ -23,7 +23,8 @@ that (transitively) requires it keeps a schedule feasible — conflicts and turn
 operated flights, and the turnaround rows are all-pairs (model.py) — and changes W by
 Σ_{g ∈ S} (ω7 − ω6 d_g / G) ≤ |S| ω7 − ω6 d_f / G. So every optimal schedule has
 d_f ≤ (1 + dependants_f) · ω7 G / ω6, and capping Δd_f there (:func:`reduced`) changes no optimum,
-continuous or on a grid. (No such cap for the lexicographic objective, where flights come first.)
+continuous or on a grid. (No such cap for the lexicographic objective, where flights come first,
+nor for a flight that must operate or that a must-operate flight requires: it cannot be cancelled.)
 """
 
 from __future__ import annotations
@@ -60,17 +61,18 @@ def reduced(problem: SchedulingProblem) -> SchedulingProblem:
 
     Evaluate schedules with the original problem (the lexicographic scalar uses Σ U; it is returned
     unchanged)."""
-    if problem.objective_kind != "weighted" or problem.weights[0] <= 0:
+    if problem.objective_kind != "weighted" or problem.objective.per_delay <= 0:
         return problem
-    w6, w7 = problem.weights
     req = problem.requires
     dependants = np.zeros(problem.n_flights, dtype=np.int64)
+    pinned = problem.must_operate.copy()  # cannot be cancelled: itself or a dependant must operate
     for f in np.flatnonzero(req >= 0):  # walk up each chain of requirements
         r = int(req[f])
         while r >= 0:
             dependants[r] += 1
+            pinned[r] |= problem.must_operate[f]
             r = int(req[r])
-    cap = (1 + dependants) * w7 * problem.aircraft_count / w6
+    cap = np.where(pinned, np.inf, (1 + dependants) * problem.objective.per_flight / problem.objective.per_delay)
     fs = problem.flights
     if np.all(cap >= fs.delay_upper_s):
         return problem

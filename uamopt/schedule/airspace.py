@@ -1,0 +1,105 @@
+"""Tracks read from files (``--network``, ``--flights``) must fly in the scenario's airspace.
+
+A planned track (Sec. 4.2) stays in admissible cells by construction; a track from a file is
+untrusted input. Before anything is scheduled each one must
+
+- lie inside the scenario's grid, [0, x_max] × [0, y_max] × [0, z_max] (Sec. 3);
+- stay above the ground datum, z > 0: flights are flown airborne (take-off and landing are not
+  modelled, docs/readings.md), so a track at z = 0 is not a flight;
+- stay above the city's surface (building tops and ground, the obstacles of Eq. 15) at every
+  point, sampled every quarter of a cell along each segment, unless ``network.tracks =
+  "straight"``, whose tracks ignore the city by definition (scheduler benchmarks).
+
+The surface is the city source on the columns of the file's own cells, each column at its highest
+point, the rule by which the planner marks obstacle cells (uamopt/risk.py), so a track planned on
+those cells never fails; a track through a 239 m tower at 120 m does.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from uamopt.errors import InputFileError
+
+if TYPE_CHECKING:
+    from uamopt.scenario import Scenario
+
+TOL_M = 1e-6  # slack for coordinates on the grid's faces, m
+SAMPLES_PER_CELL = 4  # surface samples per cell side along a segment
+
+
+def _points(waypoints: np.ndarray, cell: tuple[float, float, float]) -> np.ndarray:
+    """Points along a track, at most a quarter of a cell apart horizontally (waypoints included)."""
+    a, b = waypoints[:-1], waypoints[1:]
+    step = min(cell[0], cell[1]) / SAMPLES_PER_CELL
+    counts = np.maximum(1, np.ceil(np.hypot(*(b - a)[:, :2].T) / step).astype(np.int64))
+    seg = np.repeat(np.arange(len(a)), counts)
+    u = (np.arange(len(seg)) - np.repeat(np.cumsum(counts) - counts, counts)) / np.repeat(counts, counts)
+    return np.vstack([a[seg] + u[:, None] * (b - a)[seg], waypoints[-1:]])
+
+
+def check_tracks(scenario: Scenario, extent, tracks: Mapping[str, np.ndarray], cell, source: str,
+                 kind: str = "route") -> None:
+    """Refuse a track outside the grid, at or below the ground, or inside a building (module docstring).
+
+    Parameters
+    ----------
+    scenario : Scenario
+        Supplies the city and ``network.tracks``.
+    extent : (x_max, y_max, z_max)
+        The scenario's grid, m (``uamopt.pipeline.scenario_grid(scenario).extent``).
+    tracks : mapping name -> (n, 3) waypoints, m
+        Routes of a network file or flights of a flights file.
+    cell : (Δx, Δy, Δz)
+        The file's cells, m (the grid its tracks were planned on).
+    source, kind : str
+        The file as the user named it (``--network net.json``) and what a track is in it (``route``,
+        ``flight``): errors say ``<source>: <kind> <name>``.
+
+    Raises
+    ------
+    InputFileError
+        The first track that breaks a rule, with the point and what it hits; or the file's cells
+        would make a grid too large for memory (``grid.memory_limit_gb``).
+    """
+    from uamopt.city import load_city
+    from uamopt.grid.grid import file_grid
+
+    def where(name: str) -> str:
+        return f"{source}: {kind} {name}"
+
+    extent = np.asarray(extent, dtype=float)
+    unique: dict[bytes, tuple[str, np.ndarray]] = {}
+    for name, w in tracks.items():  # flights on one route share a track: check it once, name the first
+        unique.setdefault(np.asarray(w, dtype=float).tobytes(), (name, np.asarray(w, dtype=float)))
+    for name, w in unique.values():
+        bad = np.any((w < -TOL_M) | (w > extent + TOL_M), axis=1)
+        if bad.any():
+            p = ", ".join(f"{v:g}" for v in w[np.argmax(bad)])
+            raise InputFileError(f"waypoint ({p}) is outside the grid [0, {', '.join(f'{e:g}' for e in extent)}] m",
+                                 where(name), "move the track inside the airspace or enlarge grid.extent")
+        if np.any(w[:, 2] <= TOL_M):
+            p = ", ".join(f"{v:g}" for v in w[np.argmax(w[:, 2] <= TOL_M)])
+            raise InputFileError(f"waypoint ({p}) is on or below the ground (z ≤ 0)", where(name),
+                                 "give the track's altitudes in metres above the ground datum (Eq. 14's band)")
+    if scenario.network.tracks == "straight":
+        return
+    grid = file_grid(tuple(extent), tuple(cell), scenario.grid.memory_limit_gb, source)
+    surface = load_city(scenario, grid).surface_height
+    shape = np.asarray(grid.shape[:2]) - 1
+    for name, w in unique.values():
+        p = _points(w, grid.cell)
+        ij = np.clip(np.floor(p[:, :2] / np.asarray(grid.cell[:2])).astype(np.int64), 0, shape)
+        top = surface[ij[:, 0], ij[:, 1]]
+        inside = p[:, 2] < top - TOL_M
+        if inside.any():
+            k = int(np.argmax(inside))
+            at = ", ".join(f"{v:.1f}" for v in p[k])
+            raise InputFileError(
+                f"the track passes through a building: ({at}) is below the city's surface at {top[k]:.1f} m "
+                f"(column {tuple(int(v) for v in ij[k])} of {', '.join(f'{c:g}' for c in grid.cell)} m cells)",
+                where(name), "re-plan it with `uamopt network` or lift it above the roofs; set network.tracks = "
+                "'straight' to schedule tracks that ignore the city")

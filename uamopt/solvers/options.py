@@ -1,0 +1,183 @@
+"""Typed solver options: each solver's ``[options]`` are applied as written or refused, never ignored.
+
+Each solver declares its own options here (name, type, accepted range, default). ``highs`` and
+``cpsat`` also pass any other key to the underlying solver; those keys are checked against the
+solver itself before the run (``highspy.Highs.setOptionValue`` and CP-SAT's ``SatParameters``),
+so an unknown name or an invalid value (``mip_rel_gap = -1``, ``"abc"``) is a one-line error
+naming the option, never a silently ignored setting.
+
+Profile-level fields (``solvers/*.toml``), strict types (a bool is not a number, a string not an int):
+
+=============== ============================== ==============================================
+key             type / range                   meaning
+=============== ============================== ==============================================
+solver          one of :data:`SOLVERS`         which solver
+time_limit_s    finite float > 0               wall-clock limit of the whole solve, model
+                                               building included, s
+seed            int in [0, 2³¹ − 1]            random seed (HiGHS and CP-SAT take 32-bit seeds)
+threads         int in [1, max(64, 4·cores)]   threads for HiGHS / CP-SAT
+options         table                          per solver, below
+=============== ============================== ==============================================
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass
+from typing import Any
+
+from uamopt.errors import UamoptError
+
+SEED_MAX = 2**31 - 1
+THREADS_MAX = max(64, 4 * (os.cpu_count() or 1))
+
+
+@dataclass(frozen=True)
+class Opt:
+    """One option: its type (float, int, bool, str), default, and an accepted range or choices."""
+
+    kind: type
+    default: Any = None
+    positive: bool = False  # numbers: > 0
+    at_least: float | None = None  # numbers: ≥ this
+    choices: tuple = ()
+
+    def check(self, key: str, value: Any, where: str) -> Any:
+        bad = UamoptError
+        if self.kind is bool:
+            if not isinstance(value, bool):
+                raise bad(f"option {key} must be true or false, got {value!r}", where, f"write {key} = true or false")
+            return value
+        if self.kind is str:
+            if not isinstance(value, str) or (self.choices and value not in self.choices):
+                raise bad(f"option {key} = {value!r} is not one of {', '.join(map(repr, self.choices))}", where,
+                          f"use one of {', '.join(self.choices)}")
+            return value
+        number = isinstance(value, (int, float)) and not isinstance(value, bool)
+        if not number or (self.kind is int and (not isinstance(value, int))) or not math.isfinite(value):
+            raise bad(f"option {key} must be a finite {'integer' if self.kind is int else 'number'}, got {value!r}",
+                      where, "fix the profile")
+        if (self.positive and not value > 0) or (self.at_least is not None and value < self.at_least):
+            accepted = "> 0" if self.positive else f"≥ {self.at_least:g}"
+            raise bad(f"option {key} = {value!r} out of range", where, f"use a value {accepted}")
+        return self.kind(value)
+
+
+POSITIVE_S = Opt(float, positive=True)
+#: each solver's own options (``ga``/``soa`` are declared by ``GeneticOptions`` in genetic.py)
+OWN: dict[str, dict[str, Opt]] = {
+    "greedy": {"step_s": POSITIVE_S, "exact_gaps": Opt(bool, False)},
+    "highs": {},
+    "cpsat": {"time_unit_s": Opt(float, 0.01, positive=True), "continuous_bound": Opt(bool, True)},
+    "rolling": {"window_s": Opt(float, 900.0, positive=True), "inner": Opt(str, "cpsat", choices=("cpsat", "highs")),
+                "window_time_limit_s": POSITIVE_S, "time_unit_s": Opt(float, 0.01, positive=True), "step_s": POSITIVE_S},
+    "timeindexed": {"step_s": Opt(float, 10.0, positive=True), "model": Opt(str, "grid", choices=("grid", "relaxed")),
+                    "engine": Opt(str, "auto", choices=("auto", "highs", "cpsat", "hybrid")),
+                    "warm_soa_s": Opt(float, 0.0, at_least=0.0), "continuous_bound_s": Opt(float, 0.0, at_least=0.0),
+                    "continuous_bound_step_s": POSITIVE_S, "mip_rel_gap": Opt(float, 0.0, at_least=0.0)},
+}
+#: solvers that hand every other option to the underlying library, after checking it there
+PASS_THROUGH = {"highs": "HiGHS", "cpsat": "CP-SAT"}
+#: library options the profile's own fields set (an option would silently fight the field)
+RESERVED = {"highs": {"time_limit": "time_limit_s", "threads": "threads", "random_seed": "seed"},
+            "cpsat": {"max_time_in_seconds": "time_limit_s", "num_workers": "threads", "num_search_workers": "threads",
+                      "random_seed": "seed"}}
+
+
+def refuse_unknown(options: dict, known: set[str], solver: str) -> None:
+    """Raise on an option the solver does not know (validate at the boundary)."""
+    unknown = sorted(set(options) - known)
+    if unknown:
+        raise UamoptError(f"unknown option '{unknown[0]}' for solver {solver}", f"profile {solver} [options]",
+                          f"valid options are {', '.join(sorted(known)) or 'none'}")
+
+
+def check_profile_fields(name: str, time_limit_s: Any, seed: Any, threads: Any) -> None:
+    """Strict types and ranges of a profile's own fields (module docstring)."""
+    where = f"profile {name}"
+    if isinstance(time_limit_s, bool) or not isinstance(time_limit_s, (int, float)) or not (
+            math.isfinite(time_limit_s) and time_limit_s > 0):
+        raise UamoptError(f"time_limit_s must be a positive number of seconds, got {time_limit_s!r}", where,
+                          "give a time limit in seconds, e.g. 60")
+    if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed <= SEED_MAX:
+        raise UamoptError(f"seed must be an integer in [0, {SEED_MAX}], got {seed!r}", where,
+                          "HiGHS and CP-SAT take 32-bit seeds; use e.g. 0")
+    if isinstance(threads, bool) or not isinstance(threads, int) or not 1 <= threads <= THREADS_MAX:
+        raise UamoptError(f"threads must be an integer in [1, {THREADS_MAX}], got {threads!r}", where,
+                          f"use 1 to {THREADS_MAX} (this machine has {os.cpu_count()} cores)")
+
+
+def check_options(solver: str, options: Any, name: str) -> None:
+    """Refuse an unknown option or an invalid value for ``solver`` (module docstring)."""
+    where = f"profile {name} [options]"
+    if not isinstance(options, dict):
+        raise UamoptError(f"[options] must be a table, got {type(options).__name__}", where, "write key = value lines")
+    if solver in ("ga", "soa"):
+        from uamopt.solvers.genetic import GeneticOptions
+
+        GeneticOptions.from_options(options, solver)
+        return
+    own = OWN[solver]
+    for key, value in options.items():
+        if key in own:
+            own[key].check(key, value, where)
+    rest = {k: v for k, v in options.items() if k not in own}
+    if not rest:
+        return
+    if solver not in PASS_THROUGH:
+        refuse_unknown(options, set(own), solver)
+    for key in rest:
+        if key in RESERVED[solver]:
+            raise UamoptError(f"option {key} is set by the profile's {RESERVED[solver][key]}", where,
+                              f"write {RESERVED[solver][key]} = ... above [options] instead")
+    (_check_highs if solver == "highs" else _check_cpsat)(rest, where)
+
+
+def _check_highs(options: dict, where: str) -> None:
+    import highspy
+
+    from uamopt.solvers.deadline import quiet_highs
+
+    h = quiet_highs()
+    for key, value in options.items():
+        if isinstance(value, bool) and h.getOptionType(key)[1] != highspy.HighsOptionType.kBool:
+            ok = False  # HiGHS would read true as 1
+        else:
+            ok = h.setOptionValue(key, value) == highspy.HighsStatus.kOk
+        if not ok:
+            known = h.getOptionType(key)[0] == highspy.HighsStatus.kOk
+            raise UamoptError(f"HiGHS {'refuses' if known else 'has no option'} {key}"
+                              + (f" = {value!r}" if known else ""), where,
+                              "see https://ergo-code.github.io/HiGHS/stable/options/definitions/")
+
+
+def _check_cpsat(options: dict, where: str) -> None:
+    """Set each option on a CP-SAT solver's parameters, then let CP-SAT check their ranges on a
+    one-variable model (milliseconds)."""
+    from ortools.sat.python import cp_model
+
+    solver = cp_model.CpSolver()
+    params = solver.parameters
+    for key, value in options.items():
+        if key.startswith("_") or not hasattr(params, key) or callable(getattr(params, key)):
+            raise UamoptError(f"CP-SAT has no parameter {key}", where, "see ortools/sat/sat_parameters.proto")
+        try:
+            current = getattr(params, key)
+            if isinstance(value, bool) != isinstance(current, bool):
+                raise TypeError("a bool for a non-bool parameter, or the reverse")
+            if isinstance(value, list):
+                getattr(params, key).extend(value)
+            else:
+                setattr(params, key, value)
+        except (AttributeError, TypeError, ValueError) as exc:
+            reason = " ".join(str(exc).split()[:12])  # pybind's message lists every signature: keep its start
+            raise UamoptError(f"CP-SAT refuses {key} = {value!r} ({reason})", where,
+                              "see ortools/sat/sat_parameters.proto") from None
+    model = cp_model.CpModel()
+    model.add_bool_or([model.new_bool_var("x")])
+    params.max_time_in_seconds = 1.0
+    params.num_workers = 1
+    if solver.solve(model) == cp_model.MODEL_INVALID:
+        raise UamoptError(f"CP-SAT refuses the options: {solver.solution_info()}", where,
+                          "see ortools/sat/sat_parameters.proto")
