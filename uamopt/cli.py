@@ -184,7 +184,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 def _interrupted(args, interrupt: KeyboardInterrupt) -> int:
     """One line for Ctrl-C or SIGTERM, true about what is in the output folder."""
-    from uamopt.interrupts import describe, exit_code
+    from uamopt.interrupts import describe, handled
     from uamopt.outputs import published
 
     folder = getattr(args, "out", None) or getattr(args, "dir", None)
@@ -193,7 +193,7 @@ def _interrupted(args, interrupt: KeyboardInterrupt) -> int:
         line = (f"{describe(interrupt)}: the results in {folder} were complete before the interrupt" if published(folder)
                 else f"{line} to {folder}")
     sys.stderr.write(line + "\n")
-    return exit_code(interrupt)
+    return handled(interrupt)
 
 
 def main(argv: list[str] | None = None) -> int:

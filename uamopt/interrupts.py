@@ -75,8 +75,17 @@ def interrupt_of(exc: BaseException) -> KeyboardInterrupt | None:
     return None
 
 
-def exit_code(interrupt: KeyboardInterrupt) -> int:
-    """130 for Ctrl-C, 143 for SIGTERM."""
+def handled(interrupt: KeyboardInterrupt) -> int:
+    """The exit code of a handled interrupt: 130 for Ctrl-C, 143 for SIGTERM.
+
+    CPython 3.11 marks a KeyboardInterrupt that leaves an ``exec`` of a string (scipy's array-API
+    layer imports numpy that way) as unhandled, even when caught later, and then ends
+    ``python -m uamopt`` by SIGINT instead of with this code; the mark is cleared here.
+    """
+    with suppress(Exception):  # another interpreter: no such mark
+        import ctypes
+
+        ctypes.c_int.in_dll(ctypes.pythonapi, "_Py_UnhandledKeyboardInterrupt").value = 0
     return EXIT_SIGTERM if isinstance(interrupt, Terminated) else EXIT_SIGINT
 
 

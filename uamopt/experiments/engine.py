@@ -69,7 +69,8 @@ def connect(scheduler: str | None, workers: int | None, tasks: int, scratch: str
         # was stopped mid-task; worker logs muted (a task's error is in its row)
         with dask.config.set({"temporary-directory": scratch}):
             cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, host="127.0.0.1",
-                                   dashboard_address="127.0.0.1:0", silence_logs=logging.CRITICAL, env={"TMPDIR": scratch})
+                                   dashboard_address="127.0.0.1:0",  # a free loopback port
+                                   silence_logs=logging.CRITICAL, env={"TMPDIR": scratch})
     finally:
         if main:
             signal.signal(signal.SIGINT, signal.SIG_DFL if previous is None else previous)
@@ -237,7 +238,7 @@ def _sweep(spec: SweepSpec, folder: ResultsFolder, scheduler, workers):
 
 def cmd_sweep(args) -> int:
     """``uamopt sweep``: run, then one summary line on stdout."""
-    from uamopt.interrupts import describe, exit_code
+    from uamopt.interrupts import describe, handled
     from uamopt.outputs import check_out_dir
 
     default = Path("out") / "sweeps" / (Path(args.sweep).stem + ("-small" if args.small else ""))
@@ -246,7 +247,7 @@ def cmd_sweep(args) -> int:
         table = sweep(args.sweep, out=out, scheduler=args.scheduler, workers=args.workers, small=args.small)
     except KeyboardInterrupt as exc:
         sys.stderr.write(f"{describe(exc)}: finished cases are saved in {out}: re-run the same command to finish\n")
-        return exit_code(exc)
+        return handled(exc)
     a = table.attrs
     errors = int((table["status"] == "error").sum())
     print(f"sweep {out}: {len(table)} rows ({errors} with errors), {a['run']} of {a['cases']} cases run now, "
