@@ -31,6 +31,7 @@ from uamopt.errors import (
     ScenarioError,
     UamoptError,
 )
+from uamopt.lazy import lazy_getattr
 
 __version__ = "0.1.0"
 
@@ -59,14 +60,13 @@ __all__ = sorted([*_LAZY, "GridError", "InfeasibleScheduleError", "InputFileErro
                   "ScenarioError", "UamoptError"])
 
 
+_lazy = lazy_getattr(__name__, _LAZY)
+
+
 def __getattr__(name: str):
-    if name in _LAZY:
-        value = getattr(importlib.import_module(_LAZY[name]), name)
-        globals()[name] = value
-        return value
     if name == "plotting":  # a package
         return importlib.import_module(f"uamopt.{name}")
-    raise AttributeError(f"module 'uamopt' has no attribute {name!r}")
+    return _lazy(name)
 
 
 def __dir__() -> list[str]:
