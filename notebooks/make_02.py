@@ -154,8 +154,8 @@ of the equivalent and optimal stages are the polyline's vertices (the corridor's
 merged; the optimal track's fillets sampled), not cells. The paper's 386 waypoints at 10 m are
 fewer than the 393 cells any 26-neighbour path between P_O's and P_D's cells visits, so the paper
 counts something else. Computing times are not comparable: the paper's A* (heuristic 0) took
-68.7 s; ours is compiled and uses an admissible transport-cost heuristic with the same optimal cost
-(docs/readings.md, *Heuristic*). The paper's midpoint rule (the row below the four stages) starts
+68.7 s; ours is compiled and uses an admissible heuristic, the plan-view relaxation, with the same
+optimal cost (docs/readings.md, *Heuristic*). The paper's midpoint rule (the row below the four stages) starts
 and ends at P_O and P_D at 120 m, while the cell centres of the grid path lie half a cell higher or
 lower: those vertical metres cost $c_v \\approx 90\\,c_h$ each, hence its higher $C_T$; the exact
 equivalent track may fly anywhere in the corridor and stays level."""),

@@ -1,8 +1,8 @@
 """The four searches of the track planner return the same optimal cost.
 
 (a) the paper's A*, heuristic 0 (Dijkstra), pure Python; (b) A* with the admissible transport
-heuristic, pure Python; (c) networkx's ``astar_path`` on the explicit graph, the reference;
-(d) the numba backend with both heuristics. They must agree to a relative 1e-9 on the paper case
+and plan-view relaxation heuristics, pure Python; (c) networkx's ``astar_path`` on the explicit
+graph, the reference; (d) the numba backend with all three heuristics. They must agree to a relative 1e-9 on the paper case
 (P_O → P_D, shortest and initial stage) and on random small cities, and every returned path must
 be a valid track: 26-neighbour moves through passable cells, no cut corner, and a cost that,
 recomputed from the path alone, equals the reported one. Whether a path exists at all is
@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import math
 
+import networkx as nx
 import numpy as np
 import pytest
 from hypothesis import event, find, given, settings
@@ -23,11 +24,13 @@ from scipy import ndimage
 
 from uamopt.errors import NoTrackError
 from uamopt.planning import SearchProblem, grid_search
+from uamopt.planning.graph import grid_graph
+from uamopt.planning.heuristic import column_bound
 from uamopt.planning.tracks import endpoint_cell
 
 #: (backend, heuristic): (a), (b), (c), (d) of the module docstring
-SEARCHES = (("python", "zero"), ("python", "transport"), ("networkx", "zero"), ("fast", "zero"),
-            ("fast", "transport"))
+SEARCHES = (("python", "zero"), ("python", "transport"), ("python", "relaxed"), ("networkx", "zero"),
+            ("fast", "zero"), ("fast", "transport"), ("fast", "relaxed"))
 REL = 1e-9
 P_O, P_D = (300.0, 300.0, 120.0), (2220.0, 4220.0, 120.0)  # Table B.3
 
@@ -91,6 +94,10 @@ def test_paper_case_searches_agree(paper_cells, stage):
     problem = model.search_problem(stage)
     results = solve_all(problem, start, goal)
     assert_agree(problem, results, start, goal)
+    # the relaxation charges the risk and buffer no altitude avoids: on the initial stage the
+    # transport bound leaves A* to expand 22 411 cells, the relaxation 255 (recorded values)
+    relaxed, transport = results[("fast", "relaxed")], results[("fast", "transport")]
+    assert relaxed.expansions * (50 if stage == "initial" else 2) < transport.expansions
     if stage == "shortest":
         # the transport heuristic is the exact cost in free space: it must prune hard here
         assert results[("fast", "transport")].expansions * 5 < results[("fast", "zero")].expansions
@@ -142,9 +149,24 @@ def connected(passable: np.ndarray, a, b) -> bool:
     return bool(labels[a] == labels[b])
 
 
+def cost_to_goal(problem: SearchProblem, goal) -> dict:
+    """The exact cost from every cell to ``goal``: networkx's Dijkstra from the goal over the grid
+    graph, each edge (u, v) walked backwards (the move v → u pays the penalty of u, the cell it
+    enters)."""
+    graph = grid_graph(problem.passable, problem.cell)
+    cell = np.asarray(problem.cell)
+
+    def backwards(u, v, data):
+        step = (np.asarray(v) - np.asarray(u)) * cell
+        transport = problem.c_h * math.hypot(step[0], step[1]) + problem.c_v * abs(step[2])
+        return problem.w_risk * 0.5 * (problem.risk[u] + problem.risk[v]) * data["length"] + transport + problem.penalty[u]
+
+    return nx.single_source_dijkstra_path_length(graph, tuple(goal), weight=backwards)
+
+
 def check_random_city(city) -> None:
     problem, start, goal = city
-    searches = SEARCHES + (("networkx", "transport"),)
+    searches = SEARCHES + (("networkx", "transport"), ("networkx", "relaxed"))
     if not connected(problem.passable, start, goal):
         event("goal walled off")
         for backend, heuristic in searches:
@@ -152,7 +174,16 @@ def check_random_city(city) -> None:
                 grid_search(problem, start, goal, backend=backend, heuristic=heuristic)
         return
     event("goal reachable")
-    assert_agree(problem, solve_all(problem, start, goal, searches), start, goal)
+    results = solve_all(problem, start, goal, searches)
+    assert_agree(problem, results, start, goal)
+    # each heuristic is a lower bound of the exact cost to the goal from every cell that reaches it
+    to_goal = cost_to_goal(problem, goal)
+    cells = np.array(list(to_goal))
+    exact = np.array(list(to_goal.values()))
+    for heuristic in ("transport", "relaxed"):
+        column_h, vertical_h = column_bound(problem, goal, heuristic)
+        bound = column_h[cells[:, 0] * problem.shape[1] + cells[:, 1]] + vertical_h * np.abs(cells[:, 2] - goal[2])
+        assert np.all(bound <= exact * (1 + REL) + 1e-12), heuristic
 
 
 @settings(max_examples=25, deadline=None, derandomize=True)
@@ -176,3 +207,21 @@ def test_random_cities_cover_both_outcomes(reachable):
     problem, start, goal = find(random_cities(), lambda city: connected(city[0].passable, city[1], city[2]) == reachable,
                                 settings=settings(database=None, max_examples=200, derandomize=True))
     assert connected(problem.passable, start, goal) == reachable
+
+
+@settings(max_examples=15, deadline=None, derandomize=True)
+@given(st.integers(0, 2**32 - 1), st.integers(2, 12), st.integers(2, 12))
+def test_relaxed_bound_is_exact_on_one_free_layer(seed, nx_, ny_):
+    """On one layer with every cell free, the plan-view relaxation is the problem itself (each
+    column holds one cell, and no move cuts a corner), so the bound must equal the exact cost to
+    the goal from every cell: this pins the relaxation's risk, transport and penalty terms."""
+    rng = np.random.default_rng(seed)
+    shape = (nx_, ny_, 1)
+    cell = tuple(float(v) for v in rng.uniform(0.5, 100.0, 3))
+    problem = SearchProblem(np.ones(shape, dtype=bool), rng.random(shape), rng.integers(0, 27, shape) * rng.uniform(0, 2),
+                            cell, float(rng.uniform(0, 10)), float(rng.uniform(0.01, 10)), float(rng.uniform(0, 10)))
+    goal = (int(rng.integers(nx_)), int(rng.integers(ny_)), 0)
+    to_goal = cost_to_goal(problem, goal)
+    column_h, _ = column_bound(problem, goal, "relaxed")
+    for (i, j, _), exact in to_goal.items():
+        assert column_h[i * ny_ + j] == pytest.approx(exact, rel=REL, abs=1e-12), (i, j)

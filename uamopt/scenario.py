@@ -272,8 +272,9 @@ class TracksConfig(_Section):
     )
     wind_speed_mps: NonNegFloat = Field(0.0, description="v_wr, actual wind, m/s; must not exceed v_we (Eq. 19)")
     search: Literal["fast", "python", "networkx"] = Field("fast", description="search backend")
-    heuristic: Literal["transport", "zero"] = Field(
-        "transport", description="A* heuristic: cheapest transport cost to the goal, or 0 (the paper's)"
+    heuristic: Literal["relaxed", "transport", "zero"] = Field(
+        "relaxed", description="A* heuristic, a lower bound of the cost to the goal: the plan-view relaxation's exact "
+        "cost (risk and buffer no altitude avoids, plus transport), the cheapest transport cost, or 0 (the paper's)"
     )
     equivalent: Literal["exact", "exact_cost", "midpoint"] = Field(
         "exact", description="equivalent track: exact shortest polyline in the corridor (SOCP), the corridor's "

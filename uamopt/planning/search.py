@@ -19,11 +19,11 @@ Backends (``backend=``):
   reference.
 - ``"networkx"``: ``networkx.astar_path`` on the explicit grid graph with the same weights.
 
-Heuristics (``heuristic=``): ``"zero"`` (the paper's A*, i.e. Dijkstra) or ``"transport"``, the
-cheapest possible transport cost to the goal, c_h'·octile(Δi Δx, Δj Δy) + c_v'·|Δk| Δz. It is a
-lower bound of every path's cost (risk and penalty terms are ≥ 0; horizontal and vertical parts of
-the moves are independent) and consistent, so A* with it returns the same optimal cost with far
-fewer expansions.
+Heuristics (``heuristic=``, ``heuristic.py``): ``"zero"`` (the paper's A*, i.e. Dijkstra),
+``"transport"`` (the cheapest transport cost to the goal) and ``"relaxed"`` (default: the exact
+cost to the goal in the plan-view relaxation, which also charges the risk and buffer a track
+cannot avoid at any altitude). All three are lower bounds of every path's cost and consistent, so
+A* returns the same optimal cost with each; the stronger the bound, the fewer cells it expands.
 """
 
 from __future__ import annotations
@@ -38,6 +38,7 @@ import numpy as np
 from numba import njit
 
 from uamopt.errors import NoTrackError
+from uamopt.planning.heuristic import HEURISTICS, column_bound
 
 
 @dataclass(frozen=True)
@@ -93,15 +94,6 @@ def move_costs(cell: tuple[float, float, float], c_h: float, c_v: float) -> tupl
     length = np.linalg.norm(step, axis=1)
     transport = c_h * np.hypot(step[:, 0], step[:, 1]) + c_v * np.abs(step[:, 2])
     return length, transport
-
-
-def transport_lower_bound(a: tuple[int, int, int], b: tuple[int, int, int], cell, c_h: float, c_v: float) -> float:
-    """Cheapest transport cost from cell a to cell b over 26-neighbour moves (the heuristic)."""
-    di, dj, dk = (abs(int(x) - int(y)) for x, y in zip(a, b))
-    dx, dy, dz = cell
-    m = min(di, dj)
-    octile = m * math.hypot(dx, dy) + (di - m) * dx + (dj - m) * dy
-    return c_h * octile + c_v * dk * dz
 
 
 # --- fast backend: numba ----------------------------------------------------------------------
@@ -163,8 +155,8 @@ def _heap_pop(keys, nodes, size):
 
 
 @_compiled
-def _astar_numba(passable, risk, penalty, priority, nx, ny, nz, dx, dy, dz, w_risk, c_h, c_v,
-                 start, goal, use_heuristic, offsets, corners, counts, lengths, transports):
+def _astar_numba(passable, risk, penalty, priority, nx, ny, nz, w_risk, start, goal, column_h, vertical_h,
+                 offsets, corners, counts, lengths, transports):
     n_cells = nx * ny * nz
     g = np.full(n_cells, np.inf)
     parent = np.full(n_cells, -1, dtype=np.int64)
@@ -172,8 +164,7 @@ def _astar_numba(passable, risk, penalty, priority, nx, ny, nz, dx, dy, dz, w_ri
     keys = np.empty(1024, dtype=np.float64)
     nodes = np.empty(1024, dtype=np.int64)
     size = 0
-    gi, gj, gk = goal // (ny * nz), (goal // nz) % ny, goal % nz
-    diag = math.sqrt(dx * dx + dy * dy)
+    gk = goal % nz
     g[start] = 0.0
     keys, nodes, size = _heap_push(keys, nodes, size, 0.0, start)
     expansions = 0
@@ -202,15 +193,14 @@ def _astar_numba(passable, risk, penalty, priority, nx, ny, nz, dx, dy, dz, w_ri
             v = (vi * ny + vj) * nz + vk
             if closed[v]:
                 continue
+            h = column_h[vi * ny + vj]
+            if h == np.inf:  # the goal is out of reach from this column even in the relaxation
+                continue
             cand = gu + w_risk * 0.5 * (risk[u] + risk[v]) * lengths[n] + transports[n] + penalty[v]
             if cand < g[v]:
                 g[v] = cand
                 parent[v] = u
-                h = 0.0
-                if use_heuristic:
-                    ai, aj = abs(vi - gi), abs(vj - gj)
-                    m = min(ai, aj)
-                    h = c_h * (m * diag + (ai - m) * dx + (aj - m) * dy) + c_v * abs(vk - gk) * dz
+                h += vertical_h * abs(vk - gk)
                 keys, nodes, size = _heap_push(keys, nodes, size, cand + h + priority[v], v)
     return g[goal], parent, expansions
 
@@ -228,13 +218,13 @@ def _priority(problem: SearchProblem) -> np.ndarray:
     return np.ascontiguousarray(problem.priority, dtype=float)
 
 
-def _fast(problem: SearchProblem, start: int, goal: int, use_heuristic: bool):
+def _fast(problem: SearchProblem, start: int, goal: int, bound: tuple[np.ndarray, float]):
     nx, ny, nz = problem.shape
     lengths, transports = move_costs(problem.cell, problem.c_h, problem.c_v)
     cost, parent, expansions = _astar_numba(
         np.ascontiguousarray(problem.passable).ravel(), np.ascontiguousarray(problem.risk, dtype=float).ravel(),
-        np.ascontiguousarray(problem.penalty, dtype=float).ravel(), _priority(problem).ravel(), nx, ny, nz, *map(float, problem.cell),
-        float(problem.w_risk), float(problem.c_h), float(problem.c_v), start, goal, use_heuristic,
+        np.ascontiguousarray(problem.penalty, dtype=float).ravel(), _priority(problem).ravel(), nx, ny, nz,
+        float(problem.w_risk), start, goal, np.ascontiguousarray(bound[0], dtype=float), float(bound[1]),
         OFFSETS, CORNERS, CORNER_COUNTS, lengths, transports,
     )
     if not np.isfinite(cost):
@@ -245,12 +235,16 @@ def _fast(problem: SearchProblem, start: int, goal: int, use_heuristic: bool):
 # --- reference backends -------------------------------------------------------------------------
 
 
-def _python(problem: SearchProblem, start: int, goal: int, use_heuristic: bool):
+def _python(problem: SearchProblem, start: int, goal: int, bound: tuple[np.ndarray, float]):
     shape = problem.shape
     passable, risk, penalty, priority = problem.passable, problem.risk, problem.penalty, _priority(problem)
     lengths, transports = move_costs(problem.cell, problem.c_h, problem.c_v)
     goal_c = np.unravel_index(goal, shape)
     start_c = tuple(int(v) for v in np.unravel_index(start, shape))
+    column_h, vertical_h = bound
+
+    def heuristic(v):
+        return float(column_h[v[0] * shape[1] + v[1]]) + vertical_h * abs(v[2] - int(goal_c[2]))
     g = {start_c: 0.0}
     parent: dict = {}
     closed: set = set()
@@ -270,11 +264,13 @@ def _python(problem: SearchProblem, start: int, goal: int, use_heuristic: bool):
                 continue
             if not all(passable[u[0] + c[0], u[1] + c[1], u[2] + c[2]] for c in CORNERS[n, : CORNER_COUNTS[n]]):
                 continue
+            h = heuristic(v)
+            if h == math.inf:
+                continue
             cand = g[u] + problem.w_risk * 0.5 * (risk[u] + risk[v]) * lengths[n] + transports[n] + penalty[v]
             if cand < g.get(v, math.inf):
                 g[v] = cand
                 parent[v] = u
-                h = transport_lower_bound(v, goal_c, problem.cell, problem.c_h, problem.c_v) if use_heuristic else 0.0
                 heapq.heappush(heap, (cand + h + priority[v], int(np.ravel_multi_index(v, shape)), v))
     goal_t = tuple(int(v) for v in goal_c)
     if goal_t not in g:
@@ -285,7 +281,7 @@ def _python(problem: SearchProblem, start: int, goal: int, use_heuristic: bool):
     return np.asarray(path[::-1], dtype=np.int64), float(g[goal_t]), expansions
 
 
-def _networkx(problem: SearchProblem, start: int, goal: int, use_heuristic: bool):
+def _networkx(problem: SearchProblem, start: int, goal: int, bound: tuple[np.ndarray, float]):
     import networkx as nx
 
     from uamopt.planning.graph import grid_graph
@@ -301,8 +297,10 @@ def _networkx(problem: SearchProblem, start: int, goal: int, use_heuristic: bool
         transport = problem.c_h * math.hypot(step[0], step[1]) + problem.c_v * abs(step[2])
         return problem.w_risk * 0.5 * (risk[u] + risk[v]) * data["length"] + transport + penalty[v]
 
-    def heuristic(u, v):
-        return transport_lower_bound(u, v, problem.cell, problem.c_h, problem.c_v) if use_heuristic else 0.0
+    column_h, vertical_h = bound
+
+    def heuristic(u, v):  # v is the goal
+        return float(column_h[u[0] * problem.shape[1] + u[1]]) + vertical_h * abs(u[2] - v[2])
 
     s, t = (tuple(int(x) for x in np.unravel_index(i, problem.shape)) for i in (start, goal))
     try:
@@ -326,13 +324,13 @@ def warm_up(backend: str = "fast") -> float:
         return 0.0
     started = time.perf_counter()
     free, zero = np.ones((2, 1, 1), dtype=bool), np.zeros((2, 1, 1))
-    _fast(SearchProblem(free, zero, zero, (1.0, 1.0, 1.0), 0.0, 1.0, 1.0), 0, 1, True)
+    _fast(SearchProblem(free, zero, zero, (1.0, 1.0, 1.0), 0.0, 1.0, 1.0), 0, 1, (np.zeros(2), 0.0))
     _WARM.add(backend)
     return time.perf_counter() - started
 
 
 def grid_search(problem: SearchProblem, start: tuple[int, int, int], goal: tuple[int, int, int], *,
-                backend: str = "fast", heuristic: str = "transport") -> SearchResult:
+                backend: str = "fast", heuristic: str = "relaxed") -> SearchResult:
     """Cheapest path of cells from ``start`` to ``goal``.
 
     Parameters
@@ -341,7 +339,8 @@ def grid_search(problem: SearchProblem, start: tuple[int, int, int], goal: tuple
     start, goal : (i, j, k)
         Passable cells.
     backend : {"fast", "python", "networkx"}
-    heuristic : {"transport", "zero"}
+    heuristic : {"relaxed", "transport", "zero"}
+        See ``uamopt/planning/heuristic.py``; the time to build the bound is part of ``seconds``.
 
     Returns
     -------
@@ -363,8 +362,8 @@ def grid_search(problem: SearchProblem, start: tuple[int, int, int], goal: tuple
     """
     if backend not in BACKENDS:
         raise ValueError(f"backend must be one of {sorted(BACKENDS)}, got {backend!r}")
-    if heuristic not in ("transport", "zero"):
-        raise ValueError(f"heuristic must be 'transport' or 'zero', got {heuristic!r}")
+    if heuristic not in HEURISTICS:
+        raise ValueError(f"heuristic must be one of {list(HEURISTICS)}, got {heuristic!r}")
     for name, c in (("start", start), ("goal", goal)):
         if len(c) != 3 or not all(0 <= int(v) < n for v, n in zip(c, problem.shape)):
             raise ValueError(f"{name} {tuple(c)} is not a cell of the grid of shape {problem.shape}")
@@ -374,7 +373,8 @@ def grid_search(problem: SearchProblem, start: tuple[int, int, int], goal: tuple
     s = int(np.ravel_multi_index(tuple(start), problem.shape))
     t = int(np.ravel_multi_index(tuple(goal), problem.shape))
     started = time.perf_counter()
-    path, cost, expansions = BACKENDS[backend](problem, s, t, heuristic == "transport")
+    bound = column_bound(problem, tuple(goal), heuristic)
+    path, cost, expansions = BACKENDS[backend](problem, s, t, bound)
     seconds = time.perf_counter() - started
     if path is None:
         raise NoTrackError(f"no admissible track joins cell {tuple(start)} and cell {tuple(goal)}", "track search",
