@@ -19,11 +19,15 @@ $(VENV)/.dev: $(VENV)/.base
 demo: $(VENV)/.base
 	$(UAMOPT) reproduce models/paper_case.toml --out out/paper_case
 
+# Two pytest workers (pytest-xdist), one per core of the 2-core CI machine, each taking whole test files
+# (a module's fixtures are then built once); TEST_WORKERS=0 runs serially.
+TEST_WORKERS ?= 2
+
 test: $(VENV)/.dev
-	$(PY) -m pytest
+	$(PY) -m pytest -n $(TEST_WORKERS) --dist loadfile
 
 test-all: $(VENV)/.dev
-	$(PY) -m pytest -m ''
+	$(PY) -m pytest -n $(TEST_WORKERS) --dist loadfile -m ''
 
 bench: $(VENV)/.dev
 	$(PY) tests/benchmarks/bench_risk.py
