@@ -14,6 +14,16 @@ PAPER_CASE = ROOT / "models" / "paper_case.toml"
 
 os.environ.setdefault("MPLBACKEND", "Agg")
 
+#: the longest test files (10-60 s each on 2 cores), run first: ``make test``'s two workers take
+#: whole files in collection order, and a long file taken last leaves the other worker idle
+LONGEST_FIRST = ("test_notebooks.py", "test_replay.py", "test_sweep.py", "test_variants.py", "test_output_safety.py",
+                 "test_benchmark.py", "test_report.py", "test_environment.py", "test_search_agreement.py")
+
+
+def pytest_collection_modifyitems(config, items):
+    rank = {name: n for n, name in enumerate(LONGEST_FIRST)}
+    items.sort(key=lambda item: rank.get(item.path.name, len(rank)))  # stable: the rest keep their order
+
 
 @pytest.fixture(scope="session")
 def root() -> Path:
