@@ -113,6 +113,9 @@ CASES = [
     ("export-summary-list", "export bluesky {d}/sched_summary_list", 2, "JSON object"),
     ("export-summary-deep", "export geojson {d}/sched_summary_deep", 2, "malformed JSON"),
     ("export-no-schedule", "export bluesky {d}/sched_no_schedule", 2, "missing schedule.csv"),
+    # export reads schedule.csv with the verifier's reader: what verify refuses, export refuses
+    ("export-operated-maybe", "export bluesky {d}/sched_operated_maybe", 2, "operated must be 1 or 0"),
+    ("export-columns", "export geojson {d}/sched_columns", 2, "needs the columns"),
     # --- solver profiles ------------------------------------------------------------------------
     *[(f"profile-{name.replace('_', '-')}", f"{SCHED.replace('greedy', '{d}/profile_' + name + '.toml')} --out {{out}}",
        2, fragment) for name, fragment in (

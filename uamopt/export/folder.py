@@ -7,15 +7,14 @@ summary.json, see :mod:`uamopt.export.frame`).
 
 from __future__ import annotations
 
-import csv
 import json
-import math
 from dataclasses import dataclass
 from pathlib import Path
 
 from uamopt.errors import InputFileError
 from uamopt.export.frame import LocalFrame, synthetic_frame
 from uamopt.schedule.flights import Flight, FlightSet, load_flights
+from uamopt.schedule.verify import read_schedule_csv
 
 
 @dataclass(frozen=True)
@@ -45,35 +44,21 @@ class ScheduleFolder:
     summary: dict
 
 
-def _number(text: str, what: str, where: str) -> float:
-    try:
-        value = float(text)
-    except (TypeError, ValueError):
-        value = math.nan
-    if not math.isfinite(value):
-        raise InputFileError(f"{what} is not a finite number: {text!r}", where, "rewrite the folder with uamopt schedule")
-    return value
-
-
 def _operated(path: Path, flights: FlightSet) -> tuple[OperatedFlight, ...]:
-    if not path.is_file():
-        raise InputFileError(f"missing {path.name}", str(path.parent), "give a folder written by uamopt schedule")
+    """The operated flights of ``schedule.csv``, read by the verifier's own reader (every field
+    checked the same way as ``uamopt verify`` does)."""
     by_id = {f.id: f for f in flights.flights}
     out = []
-    with open(path, newline="", encoding="utf-8-sig") as fh:  # -sig: a spreadsheet's BOM is not a column name
-        reader = csv.DictReader(fh)
-        need = ("flight", "operated", "departure_s", "arrival_s")
-        if reader.fieldnames is None or any(c not in reader.fieldnames for c in need):
-            raise InputFileError(f"schedule.csv needs the columns {', '.join(need)}", str(path), "rewrite it with uamopt schedule")
-        for n, row in enumerate(reader, start=2):
-            where = f"{path}: line {n}"
-            if row["operated"].strip().lower() not in ("1", "true"):
-                continue
-            flight = by_id.get(row["flight"])
-            if flight is None:
-                raise InputFileError(f"flight {row['flight']!r} is not in flights.json", where, "rewrite the folder with uamopt schedule")
-            out.append(OperatedFlight(flight, _number(row["departure_s"], "departure_s", where),
-                                      _number(row["arrival_s"], "arrival_s", where)))
+    for flight_id, rec in read_schedule_csv(path).items():
+        where = f"{path}: line {rec['line']}"
+        if rec["duplicate"]:
+            raise InputFileError(f"flight {flight_id!r} appears more than once", where, "rewrite it with uamopt schedule")
+        if not rec["operated"]:
+            continue
+        flight = by_id.get(flight_id)
+        if flight is None:
+            raise InputFileError(f"flight {flight_id!r} is not in flights.json", where, "rewrite the folder with uamopt schedule")
+        out.append(OperatedFlight(flight, rec["departure"], rec["arrival"]))
     return tuple(sorted(out, key=lambda o: (o.departure_s, o.flight.id)))
 
 

@@ -194,7 +194,12 @@ def _check_work(spec: dict, where: str) -> None:
                              "rewrite the folder with uamopt schedule (cells in metres, as planned)")
 
 
-def _read_schedule(path: Path) -> dict[str, dict]:
+def read_schedule_csv(path: Path) -> dict[str, dict]:
+    """The rows of a ``schedule.csv`` by flight id, every field checked (``InputFileError`` on the
+    first malformed one): ``operated`` (bool), ``planned``, ``delay``, and for an operated flight
+    ``departure`` and ``arrival`` (s); ``line`` (its line in the file), ``duplicate`` (the id
+    appears more than once; the first row is kept) and the raw ``row``. ``uamopt export`` reads
+    folders with it too, so a file the verifier refuses is refused there the same way."""
     if not path.is_file():
         raise InputFileError(f"missing {path.name}", str(path.parent), "give a folder written by uamopt schedule")
     rows: dict[str, dict] = {}
@@ -217,7 +222,7 @@ def _parse_schedule(path: Path, rows: dict[str, dict]) -> dict[str, dict]:
             if flag not in ("1", "0", "true", "false"):
                 raise InputFileError(f"operated must be 1 or 0, got {row['operated']!r}", where, "rewrite it with uamopt schedule")
             on = flag in ("1", "true")
-            rec = {"row": row, "operated": on, "duplicate": row["flight"] in rows,
+            rec = {"row": row, "line": n, "operated": on, "duplicate": row["flight"] in rows,
                    "planned": _number(row["planned_departure_s"], "planned_departure_s", where),
                    "delay": _number(row["delay_s"] or 0.0, "delay_s", where)}
             if on:
@@ -284,7 +289,7 @@ def _conflicts(flights: list[dict], cell, radius: int) -> list[str]:
 def verify_files(flights_path: Path, schedule_path: Path, summary_path: Path | None = None) -> list[str]:
     """Violations of the schedule in ``schedule_path`` for the flights of ``flights_path``."""
     spec = _read_flights(flights_path)
-    rows = _read_schedule(schedule_path)
+    rows = read_schedule_csv(schedule_path)
     out: list[str] = []
     ids = {f["id"] for f in spec["flights"]}
     out += [f"flight {fid}: in schedule.csv but not in flights.json" for fid in rows if fid not in ids]
