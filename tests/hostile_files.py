@@ -245,6 +245,26 @@ def write_folders(d: Path) -> None:
     folder("objective_inf", edit_summary=lambda doc: doc.__setitem__("objective", float("inf")))
     folder("off_grid", lambda doc: doc["flights"][0].__setitem__("waypoints", [[300, 300, 290], [2220, 9e5, 290]]))
     folder("sunk", lambda doc: doc["flights"][0].__setitem__("waypoints", [[300, 300, -5], [2220, 4220, -5]]))
+    write_npz_bomb(d / "risk_bomb" / "risk.npz")
+    (d / "risk_bomb" / "summary.json").write_text("{}", encoding="utf-8")
+
+
+def write_npz_bomb(path: Path) -> None:
+    """A 700-byte risk.npz whose ``unsafe`` member declares a 10⁵ × 10⁵ × 100 array (931 GiB)."""
+    import io
+    import zipfile
+
+    from numpy.lib import format as npy
+
+    path.parent.mkdir(parents=True, exist_ok=True)
+    header = io.BytesIO()
+    npy.write_array_header_1_0(header, {"descr": "|b1", "fortran_order": False, "shape": (100_000, 100_000, 100)})
+    with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as archive:
+        archive.writestr("unsafe.npy", header.getvalue() + bytes(1000))
+        for name in ("obstacle", "z", "cell"):
+            small = io.BytesIO()
+            np.save(small, np.zeros(3))
+            archive.writestr(f"{name}.npy", small.getvalue())
 
 
 def write_all(d: Path) -> Path:

@@ -116,6 +116,7 @@ CASES = [
     # export reads schedule.csv with the verifier's reader: what verify refuses, export refuses
     ("export-operated-maybe", "export bluesky {d}/sched_operated_maybe", 2, "operated must be 1 or 0"),
     ("export-columns", "export geojson {d}/sched_columns", 2, "needs the columns"),
+    ("export-risk-bomb", "export geojson {d}/good --risk {d}/risk_bomb/risk.npz", 2, "declares 931.3 GiB of arrays"),
     # --- solver profiles ------------------------------------------------------------------------
     *[(f"profile-{name.replace('_', '-')}", f"{SCHED.replace('greedy', '{d}/profile_' + name + '.toml')} --out {{out}}",
        2, fragment) for name, fragment in (
@@ -241,3 +242,12 @@ def test_no_traceback_reaches_the_terminal(name, files, tmp_path):
     run = subprocess.run([sys.executable, "-m", "uamopt", *_argv(case[1], files, out)], cwd=ROOT,
                          capture_output=True, text=True, timeout=120, check=False)
     _assert_outcome(case, run.returncode, run.stdout, run.stderr, out, before, _snapshot(files))
+
+
+def test_a_risk_folder_declaring_a_huge_array_is_refused_before_decompression(files):
+    """``load_risk`` reads risk.npz through the same size check as ``export geojson --risk``."""
+    import uamopt as ua
+    from uamopt.errors import InputFileError
+
+    with pytest.raises(InputFileError, match=r"risk\.npz declares 931\.3 GiB of arrays, more than"):
+        ua.load_risk(files / "risk_bomb")

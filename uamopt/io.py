@@ -32,6 +32,42 @@ def _file(path: str | Path, name: str) -> Path:
     return path
 
 
+def read_npz(path: Path, fix: str, names=None, limit_gb: float | None = None) -> dict[str, np.ndarray]:
+    """The arrays ``names`` (default: all) of the .npz file ``path``, refused (``InputFileError``,
+    ``fix`` in the message) before anything is decompressed when the sizes their .npy headers
+    declare add up to more than ``limit_gb`` (default: 80 % of this machine's memory, as
+    ``grid.memory_limit_gb``): a few megabytes of compressed zeros can declare tens of gigabytes.
+    A missing name is left out (the caller names what it lacks)."""
+    import zipfile
+
+    from numpy.lib import format as npy
+
+    from uamopt.grid.grid import memory_limit_bytes
+
+    where = str(path)
+    try:
+        declared = 0
+        with zipfile.ZipFile(path) as archive:
+            for info in archive.infolist():
+                if names is not None and info.filename.removesuffix(".npy") not in names:
+                    continue
+                with archive.open(info) as member:
+                    version = npy.read_magic(member)
+                    if version not in ((1, 0), (2, 0)):
+                        raise ValueError(f"member {info.filename} has .npy format version {version}")
+                    read_header = npy.read_array_header_1_0 if version == (1, 0) else npy.read_array_header_2_0
+                    shape, _, dtype = read_header(member)
+                declared += int(np.prod(shape, dtype=np.float64) * dtype.itemsize)
+        limit = memory_limit_bytes(limit_gb)
+        if declared > limit:
+            raise InputFileError(f"{path.name} declares {declared / 2**30:,.1f} GiB of arrays, more than the "
+                                 f"{limit / 2**30:,.1f} GiB allowed", where, fix)
+        with np.load(path) as data:
+            return {name: data[name] for name in data.files if names is None or name in names}
+    except (OSError, ValueError, EOFError, zipfile.BadZipFile) as exc:
+        raise InputFileError(f"cannot read {path.name}: {exc}", where, fix) from None
+
+
 def _json(path: Path) -> dict:
     try:
         doc = json.loads(path.read_text(encoding="utf-8-sig"))
@@ -52,9 +88,8 @@ def load_risk(path: str | Path) -> RiskField:
 
     npz = _file(path, "risk.npz")
     summary = _json(_file(npz.parent, "summary.json"))
+    a = read_npz(npz, "regenerate it with `uamopt risk`")
     try:
-        with np.load(npz) as data:
-            a = {k: data[k] for k in data.files}
         grid = AirspaceGrid(cell=tuple(float(c) for c in a["cell"]), shape=a["risk"].shape)  # type: ignore[arg-type]
         city = CityLayers(
             surface_height=a["surface_height"], building_height=a["building_height"], road_length=a["road_length"],

@@ -29,6 +29,7 @@ import shapely.geometry
 from shapely.geometry.polygon import orient
 
 from uamopt.errors import InputFileError
+from uamopt.io import read_npz
 from uamopt.export.folder import (
     ScheduleFolder,
     read_schedule_folder,
@@ -116,13 +117,14 @@ def _unsafe_layers(folder: ScheduleFolder, risk: str | Path | None, scenario: st
         path = Path(risk)
         if not path.is_file():
             raise InputFileError(f"risk file not found: {path}", "--risk", "give a risk.npz written by uamopt risk")
+        fix = "give a risk.npz written by uamopt risk"
+        data = read_npz(path, fix, ("unsafe", "obstacle", "z", "cell"))  # sizes checked before decompressing
         try:
-            with np.load(path) as data:
-                unsafe, obstacle, z = data["unsafe"].astype(bool), data["obstacle"].astype(bool), data["z"]
-                cell = tuple(float(c) for c in data["cell"])
-                band = None  # risk.npz does not record the altitude band
-        except (OSError, KeyError, ValueError) as exc:
-            raise InputFileError(f"cannot read {path.name}: {exc}", str(path), "give a risk.npz written by uamopt risk") from None
+            unsafe, obstacle, z = data["unsafe"].astype(bool), data["obstacle"].astype(bool), data["z"]
+            cell = tuple(float(c) for c in data["cell"])
+            band = None  # risk.npz does not record the altitude band
+        except (KeyError, ValueError, TypeError) as exc:
+            raise InputFileError(f"cannot read {path.name}: {exc}", str(path), fix) from None
         return unsafe, obstacle, cell, z, band
     from uamopt.pipeline import compute_risk
 
