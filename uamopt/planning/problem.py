@@ -96,8 +96,14 @@ def clearance_ok(building: np.ndarray, cell: tuple[float, float, float], clearan
         return np.ones(building.shape, dtype=bool)
     if building.all():
         return np.zeros(building.shape, dtype=bool)
-    distance = ndimage.distance_transform_edt(~building, sampling=cell)
-    return distance >= clearance_m - 1e-9
+    # a layer s_min or more above the highest building cell is clear: the distance transform (the
+    # planning model's largest cost at fine cells) runs on the layers below it only
+    top = int(np.flatnonzero(building.any(axis=(0, 1)))[-1])
+    below = min(building.shape[2], top + int(math.ceil(clearance_m / cell[2] - 1e-9)))
+    ok = np.ones(building.shape, dtype=bool)
+    distance = ndimage.distance_transform_edt(~building[:, :, :below], sampling=cell)
+    ok[:, :, :below] = distance >= clearance_m - 1e-9
+    return ok
 
 
 #: Risk weight of the shortest-track search, ¥ per metre of R = 1: a tie-break only. A whole
