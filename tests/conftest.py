@@ -20,6 +20,20 @@ LONGEST_FIRST = ("test_notebooks.py", "test_replay.py", "test_sweep.py", "test_v
                  "test_benchmark.py", "test_report.py", "test_environment.py", "test_search_agreement.py")
 
 
+@pytest.hookimpl(tryfirst=True)
+def pytest_sessionstart(session):
+    """Fill the on-disk caches once, in the controlling process, before ``make test``'s workers
+    start: on a fresh clone each worker and each command run as a subprocess would otherwise
+    compile the numba search for itself (about 7 s each), and on a fresh machine build
+    matplotlib's font cache for itself. Both are instant when the caches exist."""
+    if not hasattr(session.config, "workerinput"):
+        import matplotlib.font_manager  # noqa: F401  (builds the font cache when there is none)
+
+        from uamopt.planning.search import warm_up
+
+        warm_up()
+
+
 def pytest_collection_modifyitems(config, items):
     rank = {name: n for n, name in enumerate(LONGEST_FIRST)}
     items.sort(key=lambda item: rank.get(item.path.name, len(rank)))  # stable: the rest keep their order
