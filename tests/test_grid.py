@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given, strategies as st
 
 from uamopt.errors import GridError
-from uamopt.grid import AirspaceGrid, altitude_band, build_grid
+from uamopt.grid import AirspaceGrid, altitude_band
 from uamopt.pipeline import scenario_grid
 from uamopt.scenario import Scenario
 

@@ -169,7 +169,7 @@ def _astar_numba(passable, risk, penalty, priority, nx, ny, nz, w_risk, start, g
     keys, nodes, size = _heap_push(keys, nodes, size, 0.0, start)
     expansions = 0
     while size > 0:
-        f, u, size = _heap_pop(keys, nodes, size)
+        _, u, size = _heap_pop(keys, nodes, size)
         if closed[u]:
             continue
         closed[u] = True

@@ -35,7 +35,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from uamopt.errors import UamoptError
 from uamopt.schedule.model import Schedule, SchedulingProblem, make_schedule
 
 CANCEL = -1  # gene value meaning "cancel this flight" (Fig. 14 extended with a cancel allele)

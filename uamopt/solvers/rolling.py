@@ -57,7 +57,6 @@ Options (``[options]`` of a profile): ``window_s`` (900), ``inner`` ("cpsat"), `
 from __future__ import annotations
 
 import dataclasses
-import math
 import time
 
 import numpy as np
