@@ -200,3 +200,14 @@ def test_share_variant_gives_table2_shape(root):
     for name in ("equivalent", "optimal"):
         assert st_[name].length_m < st_["initial"].length_m, name
     assert st_["initial"].extra["search_cost"] == pytest.approx(st_["initial"].objective + st_["initial"].buffer_cost, rel=1e-9)
+
+
+def test_the_optimal_track_keeps_the_buffer_the_initial_track_kept(model):
+    """With μ > 0 the corner fillets may leave the corridor only through cells outside every buffer
+    shell (R(t) = 0 of Eq. 35): the paper case's initial track pays no buffer (Eq. 34), so the
+    smoothed track may not either. Smoothing that ignored the shells entered one here (μ·R(t) = 100)."""
+    plan = plan_track(model, P_O, P_D)
+    assert plan.stages["initial"].buffer_cost == 0.0
+    assert plan.stages["optimal"].buffer_cost == 0.0
+    assert plan.stages["optimal"].extra["rounded_corners"] > 0  # the fillets still round corners
+    assert plan.stages["optimal"].length_m < plan.stages["equivalent"].length_m

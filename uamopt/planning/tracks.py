@@ -190,9 +190,12 @@ def exact_equivalent_track(path: np.ndarray, cell, origin, destination, *, model
 
 def smoothing_mask(model: PlanningModel, corridor: np.ndarray) -> np.ndarray:
     """Where the smoothed track may fly: the corridor, and admissible cells that are safe (Eq. 9
-    R = 0). Cutting a corner through a risky cell the corridor avoided would undo the planner's
-    work, so that counts as a violation to repair."""
+    R = 0) and, when the safety buffer is on (μ > 0), outside every buffer shell (R(t) = 0 of
+    Eq. 35). Cutting a corner through a risky cell or a buffer cell the corridor avoided would
+    undo the planner's work, so that counts as a violation to repair."""
     mask = model.admissible & ~model.field.unsafe
+    if model.scenario.tracks.buffer_penalty > 0:
+        mask &= model.shell_count == 0
     mask[tuple(np.asarray(corridor).T)] = True
     return mask
 
