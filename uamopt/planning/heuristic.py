@@ -39,13 +39,14 @@ import numpy as np
 HEURISTICS = ("relaxed", "transport", "zero")
 
 
-def _plan_view_graph(problem, c_h: float):
+def _plan_view_graph(problem):
     """The relaxation's column graph as a sparse matrix (rows: from-column, columns: to-column)."""
     from scipy.sparse import csr_matrix
 
     passable = problem.passable
     nx, ny, _ = passable.shape
     dx, dy, _ = problem.cell
+    c_h = float(problem.c_h)
     column_ok = passable.any(axis=2)
     # the risk and penalty are charged only where the track may fly: their minima over admissible cells
     min_risk = np.min(problem.risk, axis=2, where=passable, initial=np.inf)  # no temporary of the grid's size
@@ -98,5 +99,5 @@ def plan_view_distance(problem, goal_column: tuple[int, int]) -> np.ndarray:
     relaxation (flat, index i·ny + j; infinite where the goal column is out of reach)."""
     from scipy.sparse.csgraph import dijkstra
 
-    graph = _plan_view_graph(problem, float(problem.c_h))
+    graph = _plan_view_graph(problem)
     return dijkstra(graph.T.tocsr(), indices=goal_column[0] * problem.shape[1] + goal_column[1])

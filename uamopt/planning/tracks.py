@@ -232,7 +232,8 @@ def smooth_track(model: PlanningModel, equivalent: np.ndarray, corridor: np.ndar
 
     Each corner's tangent distance starts at min(``tracks.smoothing_m``, half of each leg) and is
     halved, corner by corner, while its fillet leaves the allowed cells (:func:`smoothing_mask`:
-    the corridor and safe admissible cells; all admissible cells without a corridor); after six
+    the corridor and safe admissible cells, outside the Eq. 35 buffer shells when μ > 0; all
+    admissible cells without a corridor); after six
     halvings the corner stays sharp. The result is admissible by construction and never longer
     (nor costlier in Eq. 12) than the equivalent track.
     """
