@@ -4,7 +4,7 @@ VENV   ?= .venv
 PY     := $(VENV)/bin/python
 UAMOPT := $(VENV)/bin/uamopt
 
-.PHONY: demo test test-all bench clean
+.PHONY: demo test test-all bench notebooks notebooks-run clean
 
 $(VENV)/.base: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -28,6 +28,23 @@ test: $(VENV)/.dev
 
 test-all: $(VENV)/.dev
 	$(PY) -m pytest -n $(TEST_WORKERS) --dist loadfile -m ''
+
+$(VENV)/.notebooks: $(VENV)/.base
+	$(PY) -m pip install --quiet -e '.[notebooks]'
+	touch $@
+
+# JupyterLab on the notebooks (full size); the kernel is this venv's Python, cwd the repository root.
+notebooks: $(VENV)/.notebooks
+	$(VENV)/bin/jupyter lab --notebook-dir=. notebooks/00_quickstart.ipynb
+
+# Every notebook executed at full size, top to bottom, into out/notebooks/ (the committed files stay output-free).
+notebooks-run: $(VENV)/.notebooks
+	mkdir -p out/notebooks
+	for nb in notebooks/*.ipynb; do \
+		start=$$(date +%s); $(VENV)/bin/jupyter nbconvert --to notebook --execute \
+			--ExecutePreprocessor.timeout=3600 --output-dir out/notebooks "$$nb" || exit 1; \
+		echo "$$nb: $$(( $$(date +%s) - start )) s"; \
+	done
 
 bench: $(VENV)/.dev
 	$(PY) tests/benchmarks/bench_risk.py

@@ -42,20 +42,23 @@ def test_bench_rows(paper_bench):
     assert table["profile"].tolist() == ["greedy"] * 2 + ["soa"] * 2 + ["highs"] * 2
     assert table["seed"].tolist() == [0, 1] * 3
     assert (table["time_limit_s"] == LIMIT_S).all()  # every profile's own limit (60 s) replaced
-    assert (table["objective_kind"] == "weighted").all()
+    assert (table["objective_kind"] == "lexicographic").all()  # the default objective (docs/readings.md)
+    assert table["model"].tolist() == ["delay grid 10 s, heuristic"] * 4 + ["continuous"] * 2
     assert table["verified"].all()
     assert (table["operated"] + table["cancelled"] == 120).all()
-    # the limit bounds the solver's own clock within 10 %; model building is reported beside it
-    assert (table["solve_seconds"] <= 1.1 * LIMIT_S).all()
+    # model building is reported beside the solver's own clock (how the limit bounds that clock is a
+    # timing claim: tests/benchmarks, not here)
     assert np.allclose(table["build_seconds"], table["wall_seconds"] - table["solve_seconds"], atol=1e-6)
     highs = table[table["profile"] == "highs"]
     assert (highs["status"] == "optimal").all() and (highs["gap"] < 1e-6).all()
     assert (highs["objective"].min() <= table["objective"] + 1e-9).all()  # the proven optimum is the best row
     greedy = table[table["profile"] == "greedy"]
     assert greedy["gap"].isna().all() and greedy["bound"].isna().all()  # undefined: empty, not 1e12
-    # Eq. 20 recomputed from the row's own counts: W = ω6·total delay / G − ω7·S
-    w = 0.6 * table["total_delay_s"] / table["aircraft"] - 0.4 * table["operated"]
-    assert np.allclose(w, table["objective"], atol=1e-6)
+    # the lexicographic scalar −S + Σd / (ΣU + 1) from the row's own counts: −S ≤ W < −S + 1, and
+    # W − (−S) grows with the total delay (one ΣU per instance)
+    assert ((table["objective"] >= -table["operated"] - 1e-9) & (table["objective"] < -table["operated"] + 1)).all()
+    scale = (table["objective"] + table["operated"]) / table["total_delay_s"].where(table["total_delay_s"] > 0)
+    assert np.allclose(scale.dropna(), scale.dropna().iloc[0], rtol=1e-9)
 
 
 def test_bench_markdown_and_progress(paper_bench):
@@ -67,8 +70,9 @@ def test_bench_markdown_and_progress(paper_bench):
     section = text.split("## By solver profile")[1].split("## Runs")[0]
     summary = [l for l in section.splitlines() if l.startswith("| paper_case | ")]
     assert [l.split(" | ")[1] for l in summary] == ["greedy", "soa", "highs"]
-    assert summary[2].split(" | ")[7] == "0"  # HiGHS: distance 0 to the best known
-    greedy_distance = float(summary[0].split(" | ")[7])
+    assert [l.split(" | ")[2] for l in summary] == ["delay grid 10 s, heuristic"] * 2 + ["continuous"]  # model
+    assert summary[2].split(" | ")[8] == "0"  # HiGHS: distance 0 to the best known
+    greedy_distance = float(summary[0].split(" | ")[8])
     assert greedy_distance == pytest.approx(100 * (table[table["profile"] == "greedy"]["objective"].median() - best)
                                             / abs(best), rel=1e-5)
     # not on a terminal: one line per finished solve

@@ -72,8 +72,13 @@ def test_paper_case_highs_and_cpsat(paper_problem, paper_highs):
     discrete = cpsat.solve(problem, CPSAT)
     cpsat_wall = time.perf_counter() - start
     print(f"\nhighs: {exact.summary()}\ncpsat: {discrete.summary()} wall {cpsat_wall:.2f} s")
-    assert exact.status == "optimal" and exact.gap < 1e-9 and exact.solve_seconds < 10.0
-    assert discrete.status == "optimal"
+    assert exact.status == "optimal" and exact.gap < 1e-9
+    # the paper case's times (track lengths over v_g) are not multiples of u = 0.01 s, so CP-SAT proves
+    # its lattice only: not "optimal" for continuous delays unless its continuous bound closes the gap
+    assert not discrete.extras["lattice_exact"]
+    closes = discrete.objective - discrete.extras["continuous_bound"] <= 1e-6 * abs(discrete.objective)
+    assert discrete.status == ("optimal" if closes else "optimal_on_grid")
+    assert discrete.bound == discrete.extras["continuous_bound"]  # the only bound it reports: a continuous one
     for schedule in (exact, discrete):
         check_feasible(problem, schedule)
     # OPT ≤ CP-SAT ≤ OPT(robust): the tolerance proved for this instance (0.0513 at u = 0.01 s;
@@ -136,11 +141,20 @@ def check_against_bruteforce(lattice: bool, problem: SchedulingProblem) -> None:
     event(f"delayed at the optimum: {oracle.total_delay_s > 0}")
     for schedule in (oracle, exact, discrete):
         check_feasible(problem, schedule)
-        assert schedule.status == "optimal"
+    assert oracle.status == exact.status == "optimal"
+    # CP-SAT: "optimal" only where its lattice holds the continuous optimum (every time a multiple of
+    # u) or its continuous bound meets its objective; else "optimal_on_grid"
+    if lattice:
+        assert discrete.status == "optimal"
+    else:
+        assert discrete.status in ("optimal", "optimal_on_grid")
+        if discrete.objective > oracle.objective + OBJ_TOL:  # the lattice missed the optimum: never "optimal"
+            assert discrete.status == "optimal_on_grid"
     assert exact.objective == pytest.approx(oracle.objective, abs=OBJ_TOL)
-    # lower bounds: HiGHS's proven bound and the rolling solver's pair-matching bound (CP-SAT's
-    # bound is of its outward-rounded model, which may lie above the true optimum)
+    # lower bounds: HiGHS's proven bound, CP-SAT's reported bound (only continuous-valid bounds are
+    # reported; its lattice's own is extras["restricted_bound"]) and the pair-matching bound
     assert exact.bound <= oracle.objective + OBJ_TOL
+    assert discrete.bound is None or discrete.bound <= oracle.objective + OBJ_TOL
     assert pair_matching_bound(problem) <= oracle.objective + OBJ_TOL
     tight = bruteforce.solve(robust(problem, UNIT_S))
     upper = original_objective(problem, tight)
@@ -184,14 +198,16 @@ def test_bruteforce_refuses_large_instances(paper_problem):
 # --- (c) time limit ---------------------------------------------------------------------------
 def test_highs_time_limit_reports_bound_and_gap(paper_straight_plan):
     """300 flights (seed 1, 50 aircraft, straight network, Δd at Eq. 29's bound; ~10,500 conflicting
-    pairs): HiGHS does not prove it in 3 s (measured: 20 s leave a 1 % gap), so the run stops at the
-    limit, model building included, with an incumbent and a bound."""
+    pairs): HiGHS does not prove it at its root node (measured: 20 s leave a 1 % gap), so a node limit
+    of 1 stops it, deterministically whatever the machine's load (a 3 s clock limit did not: at load
+    7-12 the model build alone took 3.6 s), with an incumbent and a bound: status "time_limit"
+    (a limit hit; milp.py maps HiGHS's node and time limits alike)."""
     from uamopt.solvers.greedy import greedy_decisions
 
     scenario, _, network, _ = paper_straight_plan
     problem = build_problem(generate_plan(scenario, network, seed=1, aircraft=50, max_delay_scale=1.0), scenario)
     started = time.perf_counter()
-    schedule = milp.solve(problem, replace(HIGHS, time_limit_s=3.0))
+    schedule = milp.solve(problem, replace(HIGHS, time_limit_s=600.0, options={"mip_max_nodes": 1}))
     print(f"\n{schedule.summary()} {schedule.extras} wall {time.perf_counter() - started:.2f} s")
     check_feasible(problem, schedule)
     assert problem.n_flights == 300 and schedule.status == "time_limit" and schedule.bound is not None

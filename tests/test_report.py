@@ -61,7 +61,7 @@ def test_reproduce_writes_the_report(reproduced):
     assert "27.4684" in report  # terminal speed at m_p = 0 beside the reference 27.468
     assert "Table 2 analogue" in report and "Route network" in report
     expected = {"risk.npz", "risk.png", "summary.json", "report.md", "tracks.json", "tracks.png", "network.json",
-                "network.png", "pareto.png", "gantt.png", "delays.png", "gantt_lexicographic.png"}
+                "network.png", "pareto.png", "gantt.png", "delays.png", "gantt_weighted.png", "delays_weighted.png"}
     assert expected <= {p.name for p in reproduced.iterdir()}
 
 

@@ -90,8 +90,8 @@ def cmd_schedule(args) -> int:
 
     scenario = _load(args)
     profile = load_profile(args.solver)
-    _, s, problems = schedule_folder(scenario, args.out, profile, args.flights, args.network, args.seed, args.set)
-    print(f"{s.solver}: {s.status}, objective {s.objective}, operated {s.operated_count}, cancelled {s.cancelled}, "
+    problem, s, problems = schedule_folder(scenario, args.out, profile, args.flights, args.network, args.seed, args.set)
+    print(f"{s.solver}: {s.status}, {problem.objective_kind} objective {s.objective}, operated {s.operated_count}, cancelled {s.cancelled}, "
           f"total delay {s.total_delay_s:.1f} s, {s.solve_seconds:.2f} s -> {Path(args.out) / 'schedule.csv'}")
     if problems:  # a solver bug, never bad input: say so loudly
         sys.stderr.write(f"error: the schedule failed verification ({len(problems)} violations, {args.out}): "

@@ -280,6 +280,14 @@ def is_paper_schedule(scenario: Scenario, problem) -> bool:
 PAPER_TABLE3 = {"greedy": (109, 11, 2401), "soa": (117, 3, 1911), "ga": (114, 6, 2161)}
 
 
+def objective_label(problem) -> str:
+    """The objective in words, as every scheduling table and figure names it."""
+    if problem.objective_kind == "lexicographic":
+        return ("objective lexicographic: most flights operated, then least total delay (the default; Eq. 20 "
+                "literal is schedule.objective = \"weighted\")")
+    return f"objective Eq. 20 weighted, (ω6, ω7) = {tuple(problem.weights)}, delays in seconds"
+
+
 def table3_section(problem, schedules: dict, verified: dict, suffix: str = "", paper: bool = True) -> str:
     """Table 3 analogue: every solver on the same flights, with each one's distance to the proven
     optimum (which the paper could not give); the paper's figures in brackets when ``paper``."""
@@ -289,7 +297,7 @@ def table3_section(problem, schedules: dict, verified: dict, suffix: str = "", p
         f"## Multi-aircraft scheduling: Table 3 analogue, {problem.objective_kind} objective (Sec. 6.2, Fig. 19)",
         "",
         f"{problem.n_flights} flights, G = {problem.aircraft_count} aircraft, {len(problem.conflicts)} conflicting "
-        f"pairs, objective Eq. 20 with (ω6, ω7) = {tuple(problem.weights)} ({problem.objective_kind}). "
+        f"pairs, {objective_label(problem)}. "
         + ("The paper's figures in brackets (operated / cancelled / total delay; its instance, not ours). "
            if paper else "The paper has no figures for this instance. ") +
         "'to optimum' is the objective's distance to the proven optimum.",

@@ -317,7 +317,9 @@ class ScheduleConfig(_Section):
         1.0, description="Δd as a share of Eq. 29's bound round(L/v_g) + ΔT (Eq. 29 allows any Δd up to it)"
     )
     objective: Literal["weighted", "lexicographic"] = Field(
-        "weighted", description="Eq. 20 (ω6 T_d − ω7 S), or most flights first then least delay"
+        "lexicographic", description="most flights first, then least total delay (default: the paper's stated aim, "
+        "docs/readings.md), or \"weighted\": the literal Eq. 20, ω6 T_d − ω7 S with delays in seconds, whose optimum "
+        "cancels a flight rather than delay it 13.3 s in the paper case"
     )
 
 

@@ -7,17 +7,17 @@ command writes. ``figures=False`` skips the PNGs (``--no-figures``).
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 
 from uamopt.scenario import Scenario
 
 
 def progress(total: int, desc: str):
-    """A progress bar on a terminal, silent otherwise."""
-    from tqdm import tqdm
+    """A progress bar on a terminal; elsewhere plain lines once the work has run 5 s
+    (:class:`uamopt.experiments.progress.Steps`)."""
+    from uamopt.experiments.progress import Steps
 
-    return tqdm(total=total, desc=desc, disable=not sys.stderr.isatty(), leave=False)
+    return Steps(total, desc)
 
 
 def write_risk(field, scenario: Scenario, folder: Path, figures: bool = True) -> dict:

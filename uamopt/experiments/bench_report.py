@@ -60,8 +60,9 @@ def summary(table):
         obj = runs["objective"].dropna()
         median = float(obj.median()) if len(obj) else math.nan
         statuses = runs["status"].value_counts()
+        models = runs["model"].dropna().unique() if "model" in runs else []
         rows.append({
-            "instance": instance, "profile": profile, "runs": len(runs),
+            "instance": instance, "profile": profile, "model": ", ".join(map(str, models)) or "-", "runs": len(runs),
             "verified": f"{int(runs['verified'].fillna(False).astype(bool).sum())}/{len(runs)}",
             "status": ", ".join(f"{s} ×{n}" for s, n in statuses.items()),
             "objective median": median,
@@ -127,10 +128,12 @@ def bench_markdown(table) -> str:
              "", "## Instances", ""] + _markdown(instances, list(instances.columns))
     lines += ["", "## By solver profile (median and range over seeds)", "",
               "`to best known %` = 100 (median objective − best known) / |best known|; `gap` = |objective − bound| / |objective| "
-              "as the solver reports its bound (empty where undefined); `solve s` is the solver's own clock, which the "
+              "with `bound` always a bound of the continuous problem (Sec. 4.3; empty where the solver has none); "
+              "`model` is what the status is about: `continuous`, `delay grid S s` or `discretised U s` (restrictions: "
+              "their `optimal_on_grid` is optimal for delays on that grid only), or a heuristic; `solve s` is the solver's own clock, which the "
               "time limit bounds, `build s` the rest of the wall time (model building, data transfer). Each solver ran "
               "once untimed on a few flights first (imports, helper processes).", ""]
-    lines += _markdown(summary(table), ["instance", "profile", "runs", "verified", "status", "objective median",
+    lines += _markdown(summary(table), ["instance", "profile", "model", "runs", "verified", "status", "objective median",
                                         "objective range", "to best known %", "gap median", "wall s median", "wall s max",
                                         "solve s median", "build s median"])
     if table["instance"].nunique() > 1:

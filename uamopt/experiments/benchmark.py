@@ -26,7 +26,7 @@ from uamopt.experiments.case import error_line, schedule_row, scheduling_problem
 from uamopt.experiments.progress import Progress
 
 COLUMNS = ["instance", "flights", "aircraft", "conflicting_pairs", "solver", "profile", "seed", "threads", "time_limit_s",
-           "objective_kind", "status", "objective", "bound", "gap", "operated", "cancelled", "total_delay_s",
+           "objective_kind", "status", "model", "objective", "bound", "gap", "operated", "cancelled", "total_delay_s",
            "avg_delay_s", "wall_seconds", "solve_seconds", "build_seconds", "verified", "error"]
 
 

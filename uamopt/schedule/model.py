@@ -46,8 +46,10 @@ from uamopt.schedule.occupancy import ConflictTable, conflict_table
 if TYPE_CHECKING:
     from uamopt.scenario import Scenario
 
-Status = Literal["optimal", "feasible", "time_limit", "infeasible", "error"]
-STATUSES = ("optimal", "feasible", "time_limit", "infeasible", "error")
+Status = Literal["optimal", "optimal_on_grid", "feasible", "time_limit", "infeasible", "error"]
+#: ``optimal``: proved for the continuous problem (Sec. 4.3); ``optimal_on_grid``: proved only for a
+#: restriction of it (delays on a grid or lattice, ``extras["model_kind"]``), not for continuous delays
+STATUSES = ("optimal", "optimal_on_grid", "feasible", "time_limit", "infeasible", "error")
 ObjectiveKind = Literal["weighted", "lexicographic"]
 
 
@@ -238,10 +240,12 @@ class Schedule:
         return frame.set_index("flight")
 
     def summary(self) -> dict:
-        """The keys of summary.json (docs/interfaces.md), plus ``model`` (what the status and bound
-        are about, e.g. a delay grid), ``continuous_bound`` (a bound valid for continuous delays) and
-        ``optimal_within`` (objective − continuous_bound) when the solver gives them."""
-        named = {key: self.extras[key] for key in ("model", "continuous_bound", "continuous_bound_model", "optimal_within")
+        """The keys of summary.json (docs/interfaces.md), plus ``model_kind`` (continuous, delay grid
+        with its step, discretised with its unit; what the status is about), ``model`` (the same in
+        words), ``continuous_bound`` (a bound valid for continuous delays; ``bound`` holds only such
+        bounds) and ``optimal_within`` (objective − continuous_bound) when the solver gives them."""
+        named = {key: self.extras[key] for key in ("model_kind", "model", "continuous_bound", "continuous_bound_model",
+                                                   "optimal_within", "restricted_bound")
                  if key in self.extras}
         return {
             "solver": self.solver, "status": self.status, "objective": self.objective, "bound": self.bound,

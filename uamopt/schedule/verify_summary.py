@@ -44,7 +44,7 @@ def check_summary(path: Path, spec: dict, flown: list[dict], n_aircraft: int) ->
         got = summary.get(key)
         if not isinstance(got, (int, float)) or not close(float(got), float(value)):
             out.append(f"summary.json: {key} = {got!r}, the schedule gives {value:.6g}")
-    if summary.get("status") not in ("optimal", "feasible", "time_limit", "infeasible", "error"):
+    if summary.get("status") not in ("optimal", "optimal_on_grid", "feasible", "time_limit", "infeasible", "error"):
         out.append(f"summary.json: unknown status {summary.get('status')!r}")
     return out
 

@@ -166,6 +166,17 @@ def replay(path: str | Path, *, dt_s: float = DEFAULT_DT_S, bank_deg: float = DE
     if not bluesky_available():
         raise UamoptError("BlueSky is not installed", "uamopt replay", INSTALL_HINT)
     folder = read_schedule_folder(path)
+    from uamopt.experiments.progress import Steps
+
+    with Steps(3, "replay") as bar:  # plain lines off a terminal once it has run 5 s (the simulation takes ~1 min)
+        return _replay(folder, bar, started, dt_s=dt_s, bank_deg=bank_deg, budget_h_m=budget_h_m,
+                       budget_v_m=budget_v_m, zone_m=zone_m, window_s=window_s, trajectory=trajectory, write=write)
+
+
+def _replay(folder: ScheduleFolder, bar, started: float, *, dt_s, bank_deg, budget_h_m, budget_v_m, zone_m, window_s,
+            trajectory, write) -> ReplayResult:
+    """:func:`replay` after the folder is read; ``bar`` counts its three steps."""
+    bar.set_description("designing the trajectories")
     zone = protected_zone(folder.flights.cell, folder.flights.conflict_radius, budget_h_m=budget_h_m,
                           budget_v_m=budget_v_m, zone_m=zone_m)
     chosen = [o for o in folder.operated if window_s is None or window_s[0] <= o.departure_s <= window_s[1]]
@@ -178,7 +189,11 @@ def replay(path: str | Path, *, dt_s: float = DEFAULT_DT_S, bank_deg: float = DE
         scn = Path(tmp) / "bluesky.scn"
         scn.write_text(text, encoding="utf-8")
         until = max(o.arrival_s for o in chosen) + 600.0
+        bar.update(1)
+        bar.set_description(f"BlueSky simulating {len(chosen)} flights to t = {until:.0f} s")
         meta, raw = _run_worker(scn, until)
+    bar.update(1)
+    bar.set_description("comparing with the plan")
     result = _compare(folder, chosen, zone, meta, raw)
     for f in result[2]:
         design = designs[f["flight"]]
@@ -198,6 +213,7 @@ def replay(path: str | Path, *, dt_s: float = DEFAULT_DT_S, bank_deg: float = DE
             plot_replay(result, stage / "replay.png")
             (stage / "bluesky.scn").write_text(text, encoding="utf-8")
             (stage / "replay.json").write_text(json.dumps(result.as_dict(), indent=2) + "\n", encoding="utf-8")
+    bar.update(1)
     return result
 
 

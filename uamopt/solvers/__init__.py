@@ -109,4 +109,25 @@ def solve(problem: SchedulingProblem, profile: SolverProfile | str) -> Schedule:
     if not isinstance(profile, SolverProfile):
         profile = load_profile(profile)
     module = importlib.import_module(SOLVERS[profile.solver])
-    return module.solve(problem, profile)
+    schedule = module.solve(problem, profile)
+    schedule.extras.setdefault("model_kind", model_kind(profile, problem))
+    return schedule
+
+
+def model_kind(profile: SolverProfile, problem: SchedulingProblem) -> str:
+    """Which problem a profile's status is about: ``continuous`` (the model of Sec. 4.3),
+    ``delay grid S s`` (delays restricted to multiples of S), ``discretised U s`` (CP-SAT's
+    lattice of U, constraints rounded outward), a relaxation, or a heuristic on one of these."""
+    o = profile.option
+    if profile.solver == "highs":
+        return "continuous"
+    if profile.solver == "cpsat":
+        return f"discretised {o('time_unit_s'):g} s"
+    if profile.solver == "timeindexed":
+        step = float(o("step_s"))
+        return f"delay grid {step:g} s" if o("model") == "grid" else f"delay cells {step:g} s (relaxation)"
+    if profile.solver == "rolling":
+        return f"time windows ({o('inner') or 'cpsat'}), heuristic"
+    if o("exact_gaps"):
+        return "continuous, heuristic"
+    return f"delay grid {float(o('step_s') or problem.time_step_s):g} s, heuristic"

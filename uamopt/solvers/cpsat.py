@@ -48,6 +48,7 @@ from uamopt.schedule.model import Schedule, SchedulingProblem, make_schedule
 
 ROUND_S = 1e-9  # float round-off accepted when rounding a real time to units, s
 INT_LIMIT = 2**62  # keep |objective| below this (CP-SAT uses int64)
+CERTIFIED_GAP = 1e-6  # objective − continuous bound, relative, at which a lattice optimum is called optimal
 
 
 def integer_objective(problem: SchedulingProblem, unit_s: float, delay_max: np.ndarray) -> tuple[int, int, float, str]:
@@ -116,6 +117,23 @@ def build_cpsat(problem: SchedulingProblem, unit_s: float = 0.01, rounding: str 
     per_unit, per_flight, divisor, how = integer_objective(problem, unit_s, delay_max)
     model.minimize(per_unit * sum(delay) - per_flight * sum(operate))
     return model, operate, delay, per_unit, per_flight, divisor, how
+
+
+def lattice_is_exact(problem: SchedulingProblem, unit_s: float, how: str) -> bool:
+    """True when the u-lattice model has the continuous model's optimum (module docstring): every
+    time of the data (planned departures, flight times, turnaround gaps, delay bounds, the pairs'
+    forbidden intervals and shifts) is a multiple of u, and the objective's integer scaling is exact."""
+    if how == "approximate":
+        return False
+    view = problem.pairs
+    times = [problem.planned_departure_s, problem.flight_time_s, problem.turnaround_after_s, problem.delay_upper_s,
+             view.lo, view.hi, view.shift]
+    for values in times:
+        units = np.asarray(values, dtype=float) / unit_s
+        finite = units[np.isfinite(units)]
+        if finite.size and np.max(np.abs(finite - np.rint(finite))) > 1e-6:
+            return False
+    return True
 
 
 def objective_bound(problem: SchedulingProblem, raw: float, per_flight: int, divisor: float, unit_s: float, how: str) -> float:
@@ -205,9 +223,14 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
     operated = np.array([solver.boolean_value(v) for v in operate])
     delay_k = [solver.value(v) for v in delay]
     delay_s = np.array(delay_k, dtype=float) * unit_s
-    status = "optimal" if code == cp_model.OPTIMAL else "time_limit"  # FEASIBLE: stopped by the time limit
-    bound = objective_bound(problem, solver.best_objective_bound, per_flight, divisor, unit_s, how)
-    schedule = no_worse(problem, make_schedule(problem, "cpsat", status, operated, delay_s, bound=bound,
+    # OPTIMAL proves the u-lattice model, a restriction: optimal_on_grid unless the continuous bound
+    # below closes the gap; the lattice bound is no bound of the continuous problem (extras only).
+    exact = lattice_is_exact(small, unit_s, how)  # then the lattice's optimum and bound are the continuous ones
+    status = ("optimal" if exact else "optimal_on_grid") if code == cp_model.OPTIMAL else "time_limit"  # FEASIBLE: the limit
+    lattice_bound = objective_bound(problem, solver.best_objective_bound, per_flight, divisor, unit_s, how)
+    extras.update(restricted_bound=lattice_bound, lattice_exact=exact)
+    schedule = no_worse(problem, make_schedule(problem, "cpsat", status, operated, delay_s,
+                                               bound=lattice_bound if exact else None,
                                                solve_seconds=seconds, seed=profile.seed, extras=extras), start)
     if want_bound and profile.time_limit_s - (time.perf_counter() - t0) > 0.5:
         inner, i_op, i_delay, _, i_flight, i_div, i_how = build_cpsat(small, unit_s, rounding="inner")
@@ -223,4 +246,10 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
             schedule.extras.update(continuous_bound=low, continuous_bound_termination=relaxed.status_name(r_code),
                                    continuous_bound_model=f"delay cells {unit_s:g} s (relaxation of the continuous model)",
                                    optimal_within=schedule.objective - low)
+            status = schedule.status
+            if status == "optimal_on_grid" and schedule.objective - low <= CERTIFIED_GAP * max(1.0, abs(low)):
+                status = "optimal"  # the continuous bound meets the lattice optimum: optimal for continuous delays
+            bound = low if schedule.bound is None else max(low, schedule.bound)  # both valid: the larger
+            schedule = make_schedule(problem, "cpsat", status, schedule.operated, schedule.delay_s, bound=bound,
+                                     solve_seconds=schedule.solve_seconds, seed=profile.seed, extras=schedule.extras)
     return dataclasses.replace(schedule, solve_seconds=time.perf_counter() - t0)

@@ -250,7 +250,7 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
     bound = result.objective_bound if result.objective_bound is not None and np.isfinite(result.objective_bound) else None
     n = problem.n_flights
     if tc in (TerminationCondition.provenInfeasible, TerminationCondition.infeasibleOrUnbounded):
-        return make_schedule(problem, "highs", "infeasible", np.zeros(n, bool), np.zeros(n), solve_seconds=seconds,
+        return make_schedule(problem, "highs", "infeasible", np.zeros(n, bool), np.zeros(n), solve_seconds=time.perf_counter() - t0,
                              seed=profile.seed, extras=extras)
     if tc == TerminationCondition.convergenceCriteriaSatisfied and has_solution:
         status = "optimal"

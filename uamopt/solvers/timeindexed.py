@@ -400,8 +400,12 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
         operated, delay = np.zeros(n, dtype=bool), np.zeros(n)
     else:
         operated, delay = model.decode(result.x)
-    status = "optimal" if result.proved else "time_limit"
-    schedule = make_schedule(problem, "timeindexed", status, operated, delay, bound=result.bound,
+    # The grid model is a restriction: "optimal" on it is not optimal for continuous delays, and its
+    # bound is no bound of the continuous problem. Status optimal_on_grid; the grid bound is kept in
+    # extras["restricted_bound"]; ``bound`` holds only the relaxed model's bound, when computed.
+    status = "optimal_on_grid" if result.proved else "time_limit"
+    extras["restricted_bound"] = result.bound
+    schedule = make_schedule(problem, "timeindexed", status, operated, delay, bound=None,
                              solve_seconds=time.perf_counter() - t0, seed=profile.seed, extras=extras)
     schedule = no_worse(problem, schedule, start)
     if cont_s > 0:
@@ -411,7 +415,9 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
         r = run_engine(engine, relaxed, problem, left, profile.threads, profile.seed, gap, None)
         schedule.extras.update(continuous_bound=r.bound, continuous_bound_model=model_name("relaxed", c_step),
                                continuous_bound_termination=r.termination)
+        if r.bound is not None and schedule.objective is not None:
+            schedule.extras["optimal_within"] = schedule.objective - r.bound
         schedule = make_schedule(problem, "timeindexed", schedule.status, schedule.operated, schedule.delay_s,
-                                 bound=schedule.bound, solve_seconds=time.perf_counter() - t0, seed=profile.seed,
+                                 bound=r.bound, solve_seconds=time.perf_counter() - t0, seed=profile.seed,
                                  extras=schedule.extras)
     return schedule

@@ -121,8 +121,10 @@ def no_worse(problem: SchedulingProblem, schedule: Schedule, start: Start) -> Sc
     extras = dict(schedule.extras, incumbent=f"warm start ({start.source}): the solver's own was "
                   f"{'none' if schedule.objective is None else f'{schedule.objective:.6f}'}")
     bound, status = schedule.bound, "time_limit"
-    if schedule.status == "optimal":  # optimal on a restricted model (a lattice) that does not hold the start
-        bound, status = None, "feasible"
-        extras["bound_dropped"] = f"{schedule.bound!r}: the optimum of {schedule.extras.get('model', 'its model')}"
+    if schedule.status in ("optimal", "optimal_on_grid"):  # optimal on a restricted model that does not hold the start
+        status = "feasible"
+        if schedule.bound is not None and schedule.bound > start.objective + 1e-9 * (1.0 + abs(start.objective)):
+            bound = None  # not a bound of the problem the start solves
+            extras["bound_dropped"] = f"{schedule.bound!r}: the optimum of {schedule.extras.get('model', 'its model')}"
     return make_schedule(problem, schedule.solver, status, start.operated, start.delay_s, bound=bound,
                          solve_seconds=schedule.solve_seconds, seed=schedule.seed, extras=extras)
