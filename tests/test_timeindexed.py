@@ -163,3 +163,17 @@ def test_highs_and_cpsat_in_one_process_either_order(root):
         assert status_a == status_b == "optimal" and loaded == "highspy,ortools"
         sign = 1.0 if order.startswith("cpsat") else -1.0  # CP-SAT's lattice optimum is ≥ the continuous one
         assert -OBJ_TOL <= sign * float(difference) <= 0.1
+
+
+def test_benchmark_names_the_model_and_reports_only_continuous_bounds(paper_problem):
+    """`exact` proves the 10 s delay grid, a restriction: its row says so (status optimal_on_grid,
+    model "delay grid 10 s"), and its bound, like every bound in the table, lies below the
+    continuous optimum that HiGHS proves in the same table."""
+    import uamopt as ua
+
+    table = ua.benchmark(paper_problem, ["exact", "highs"], seeds=[0], time_limit_s=60, progress=False)
+    exact, highs = (table[table["profile"] == name].iloc[0] for name in ("exact", "highs"))
+    assert (exact["status"], exact["model"]) == ("optimal_on_grid", "delay grid 10 s")
+    assert (highs["status"], highs["model"]) == ("optimal", "continuous")
+    assert exact["bound"] <= highs["objective"] + OBJ_TOL and highs["bound"] <= highs["objective"] + OBJ_TOL
+    assert exact["objective"] >= highs["objective"] - OBJ_TOL and table["verified"].all()

@@ -104,7 +104,7 @@ class Steps:
         return now - self.start >= self.after_s and now - self.last >= self.interval_s
 
     def _tick(self) -> None:
-        while not self._stop.wait(0.5):
+        while not self._stop.wait(min(0.5, self.interval_s)):
             if self._due():
                 self._line(self.note)
 
