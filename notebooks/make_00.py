@@ -20,13 +20,20 @@ field = ua.compute_risk(scenario)
 summary = field.summary()
 assert summary["grid"]["shape"] == [50, 90, 12]  # 2500 × 4500 × 360 m in 50 × 50 × 30 m cells (Sec. 6.2)
 print(f"{summary['cells']:,} cells, {summary['unsafe_share']:.1%} unsafe")"""),
-    md("## Table 2: one track in four stages, V1 → V4 (P_O → P_D of Table B.3)"),
+    md("""## Table 2: one track in four stages, V1 → V4 (P_O → P_D of Table B.3)
+
+At the scenario's own 50 × 50 × 30 m cells, so that this notebook runs in seconds. The paper's
+Table 2 is at 10 m cells (C_R 196 for its shortest track), and C_R is not comparable across cell
+sizes: the road term R^V of a cell grows with the road length inside it (Eq. 7, l_r per cell), so
+the 50 m risks here are several times the 10 m ones. Notebook 02 runs Table 2 at 10 m, as
+`uamopt reproduce` does (`ua.load_scenario(..., ["grid.cell=[10,10,10]"])`)."""),
     code("""model = ua.planning_model(scenario, field)
 plan = ua.plan_track(model, "V1", "V4")
 table2 = plan.to_frame()
 assert (table2["length_m"] >= 4365.0 - 1e-6).all()  # never shorter than |V4 − V1| = 4365 m (Table B.3 L_14)
 table2"""),
-    code("""fig = ua.plotting.tracks(plan, model, title="V1 → V4")"""),
+    code("""fig = ua.plotting.tracks(plan, model, title="V1 → V4 at 50 m cells")
+fig  # the last expression of a cell is what Jupyter shows"""),
     md("## The route network and the flight plan (Sec. 6.2, Eq. 23)"),
     code("""network = ua.plan_network(model)
 flights = ua.generate_flights(scenario, network)
@@ -39,6 +46,7 @@ schedules = {name: ua.solve(problem, name, time_limit_s=30) for name in ("greedy
 for name, schedule in schedules.items():
     assert ua.verify(problem, schedule).ok, name
     print(f"{name:7s} {schedule.status:9s} objective {schedule.objective:9.4f} operated {schedule.operated_count}")
+print(f"objective: {problem.objective_kind} (most flights, then least delay; docs/readings.md)")
 assert schedules["highs"].status == "optimal"
 assert schedules["highs"].objective <= min(s.objective for s in schedules.values()) + 1e-6"""),
     md("## A benchmark table (seeds × solvers, one time limit)"),

@@ -108,7 +108,7 @@ changes are against the shortest track, as in the paper."""),
 PAPER_TABLE2_CHANGE = {  # as printed in Table 2 (they differ slightly from the values' own ratios)
     "initial": ("-11.36%", "+20.56%", "+18.07%", "+31.83%"), "equivalent": ("-11.36%", "+18.16%", "+17.25%", "+48.39%"),
     "optimal": ("-7.69%", "+13.59%", "+11.73%", "+58.60%")}
-QUANTITIES = ("operational risk C_R (Eq. 11)", "transport cost C_T (¥, Eq. 12)", "waypoints", "computing time (s)")
+QUANTITIES = ("operational risk C_R (Eq. 11)", "transport cost C_T (¥, Eq. 12)", "waypoints", "time of the four track stages (s; risk field and planning model not included)")
 FORMATS = ("{:.1f}", "{:.4f}", "{:.0f}", "{:.3g}")  # per quantity
 ours = plan.to_frame()
 ours.loc["equivalent, midpoint rule"] = [getattr(plan.midpoint, c) for c in ours.columns]
