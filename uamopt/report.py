@@ -213,7 +213,8 @@ def table4_section(scenario: Scenario, results: list, paper: bool = True) -> str
         + ("The paper's figures in brackets (its Table 4 reports the shortest-track column of Table 2)."
            if paper else "The paper has no figures for this track."),
         "",
-        "| cells | operational risk C_R | transport cost (¥) | waypoints | length (m) | time (s) |",
+        "| cells | operational risk C_R | transport cost (¥) | waypoints | length (m) | time: risk field, planning model "
+        "and four stages (s) |",
         "|---|---|---|---|---|---|",
     ]
     for side, plan, seconds in results:
