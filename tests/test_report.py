@@ -63,6 +63,9 @@ def test_reproduce_writes_the_report(reproduced):
     expected = {"risk.npz", "risk.png", "summary.json", "report.md", "tracks.json", "tracks.png", "network.json",
                 "network.png", "pareto.png", "gantt.png", "delays.png", "gantt_weighted.png", "delays_weighted.png"}
     assert expected <= {p.name for p in reproduced.iterdir()}
+    for objective in ("lexicographic", "weighted"):  # a Gantt per solver, not only the best one's
+        assert all((reproduced / "schedules" / objective / s / "gantt.png").stat().st_size > 0
+                   for s in ("greedy", "ga", "soa", "highs", "cpsat"))
 
 
 @pytest.mark.parametrize("objective", ["weighted", "lexicographic"])

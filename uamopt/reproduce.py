@@ -48,6 +48,10 @@ def schedule_sections(scenario: Scenario, network, stage: Path, bar, provenance:
             folder = stage / "schedules" / objective / name
             write_schedule(folder, problem, schedule, extra=provenance)
             schedules[name], verified[name] = schedule, not verify_dir(folder)
+            if figures:  # every solver's own Gantt beside its files (the report shows the best one's)
+                from uamopt import plotting
+
+                plotting.save(plotting.gantt(problem, schedule), folder / "gantt.png")
             bar.update(1)
         suffix = "" if objective == first else f"_{objective}"
         if figures:
