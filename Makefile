@@ -4,7 +4,7 @@ VENV   ?= .venv
 PY     := $(VENV)/bin/python
 UAMOPT := $(VENV)/bin/uamopt
 
-.PHONY: demo test test-all bench notebooks notebooks-run clean
+.PHONY: demo test test-slow test-all bench notebooks notebooks-run clean
 
 $(VENV)/.base: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -25,6 +25,10 @@ TEST_WORKERS ?= 2
 
 test: $(VENV)/.dev
 	$(PY) -m pytest -n $(TEST_WORKERS) --dist loadfile
+
+# The slow tests only (full-size notebooks, the 2,000-instance brute-force sweep, the 200-city search sweep, ...).
+test-slow: $(VENV)/.dev
+	$(PY) -m pytest -n $(TEST_WORKERS) --dist loadfile -m slow
 
 test-all: $(VENV)/.dev
 	$(PY) -m pytest -n $(TEST_WORKERS) --dist loadfile -m ''
