@@ -18,18 +18,39 @@ from pathlib import Path
 
 import numpy as np
 
+TINY = 1e-9  # a value below this (rounding noise, e.g. a gap of 1.3e-15) is printed as 0
 
-def _num(value, digits: int = 6) -> str:
-    if value is None or (isinstance(value, float) and not math.isfinite(value)):
+
+def _seconds(value: float) -> str:
+    """Three significant digits, never in exponent form: 0.00869, 12.3, 1230."""
+    value = float(f"{value:.3g}")
+    places = max(0, 2 - math.floor(math.log10(abs(value))))
+    return f"{value:.{places}f}"
+
+
+def _num(value, digits: int = 6, column: str = "") -> str:
+    """A table cell of bench.md: ``-`` when missing; a ``gap`` column as a percentage with two
+    decimals; a timing column (``wall s median``, ``solve_seconds``, ``time_limit_s``, ...) to
+    three significant digits; other numbers to ``digits``; below 1e-9 in magnitude, 0."""
+    import pandas as pd
+
+    if value is None or value is pd.NA or (isinstance(value, float) and not math.isfinite(value)):
         return "-"
     if isinstance(value, (float, np.floating)):
+        if "gap" in column:
+            return "0.00 %" if abs(value) < TINY else f"{100.0 * value:.2f} %"
+        if abs(value) < TINY:
+            return "0"
+        if " s " in f" {column} " or "seconds" in column or column == "time_limit_s":
+            return _seconds(value)
         return f"{value:.{digits}g}"
     return str(value)
 
 
 def _markdown(frame, columns: list[str]) -> list[str]:
     lines = ["| " + " | ".join(columns) + " |", "|" + "---|" * len(columns)]
-    lines += ["| " + " | ".join(_num(v) for v in row) + " |" for row in frame[columns].itertuples(index=False)]
+    lines += ["| " + " | ".join(_num(v, column=c) for c, v in zip(columns, row)) + " |"
+              for row in frame[columns].itertuples(index=False)]
     return lines
 
 
