@@ -225,7 +225,7 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
     delay_s = np.array(delay_k, dtype=float) * unit_s
     # OPTIMAL proves the u-lattice model, a restriction: optimal_on_grid unless the continuous bound
     # below closes the gap; the lattice bound is no bound of the continuous problem (extras only).
-    exact = lattice_is_exact(small, unit_s, how)  # then the lattice's optimum and bound are the continuous ones
+    exact = lattice_is_exact(problem, unit_s, how)  # (the data, not the dominance caps of `small`) then the lattice's optimum and bound are the continuous ones
     status = ("optimal" if exact else "optimal_on_grid") if code == cp_model.OPTIMAL else "time_limit"  # FEASIBLE: the limit
     lattice_bound = objective_bound(problem, solver.best_objective_bound, per_flight, divisor, unit_s, how)
     extras.update(restricted_bound=lattice_bound, lattice_exact=exact)
