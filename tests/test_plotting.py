@@ -174,7 +174,9 @@ def test_network_draws_every_track(paper):
     ax_map, ax_profile = fig.subplots(1, 2)
     plotting.network(model, {"routes": {k: {"waypoints": v.tolist()} for k, v in routes.items()}},
                      [ax_map, ax_profile])  # a network.json document
-    assert len(ax_map.lines) == 3 and len(ax_profile.lines) == 3 + 2  # and the band's two edges
+    assert len(ax_map.lines) == 3
+    # (b): a row per route (V1-V4 with its way back, V1-X), each track's altitude profile in its row
+    assert [[line.get_label() for line in row.lines] for row in ax_profile.child_axes] == [["V1-V4", "V4-V1"], ["V1-X"]]
     assert isinstance(plotting.network(model, routes), Figure)
     with pytest.raises(ValueError, match="at least one route"):
         plotting.network(model, {})
@@ -219,7 +221,8 @@ def test_gantt_draws_one_bar_per_operated_flight(schedules):
     assert [tuple(seg[:, 0]) for seg in delay_lines.get_segments()] == [
         (problem.planned_departure_s[0], problem.planned_departure_s[0] + 30.0),
         (problem.planned_departure_s[4], problem.planned_departure_s[4] + 60.0)]
-    assert ax.get_title() == "by hand: 117 operated, 3 cancelled, total delay 90 s"
+    assert ax.get_title() == ("by hand: 117 operated, 3 cancelled, total delay 90 s — objective lexicographic: most "
+                              "flights, then least delay")
     assert isinstance(plotting.gantt(problem, schedule), Figure)
 
 

@@ -198,6 +198,22 @@ class RiskField:
         """Layer indices inside the altitude band of Eq. 14."""
         return self.grid.layers_in_band(*self.band)
 
+    def unsafe_share(self, layers=None) -> float:
+        """Share of the free cells (not inside or below a building, Eq. 9's obstacles) that are
+        unsafe (Eq. 9: R > R_0 or no-fly), over ``layers``: None for the altitude band of
+        Eq. 14 (``summary()["band_unsafe_share"]``, the report's and ``risk.png``'s figure), "all"
+        for the whole grid, else a sequence of layer indices. 0 when those layers hold no free
+        cell. Obstacle cells are left out of both counts: they are unsafe by definition and
+        nobody could fly there anyway."""
+        if layers is None:
+            layers = self.band_layers()
+        elif isinstance(layers, str) and layers == "all":
+            layers = np.arange(self.grid.shape[2])
+        layers = np.asarray(layers, dtype=int).reshape(-1)
+        free = ~self.obstacle[:, :, layers]
+        n = int(free.sum())
+        return float(self.unsafe[:, :, layers][free].sum() / n) if n else 0.0
+
     def arrays(self) -> dict[str, np.ndarray]:
         """The arrays of ``risk.npz`` (docs/interfaces.md)."""
         g = self.grid
@@ -248,7 +264,7 @@ class RiskField:
             "band_m": list(self.band),
             "band_layers": [int(k) for k in band],
             "band_free_cells": int(band_free.sum()),
-            "band_unsafe_share": share(self.unsafe, band_free),
+            "band_unsafe_share": self.unsafe_share(),  # of the band's free cells, as risk.png
             "unsafe_share_by_layer": {f"{z:g}": share(self.unsafe[:, :, k], free[:, :, k]) for k, z in enumerate(g.z)},
             "road_columns_share": float((self.city.road_length > 0).mean()),
             "road_driven_unsafe_share": share(road_driven, free),

@@ -16,11 +16,11 @@ function                      draws                                             
 :func:`risk`                  risk map, city, section, profiles (Eqs. 8–9, 14)    5
 :func:`risk_components`       each term of Eq. 8 by altitude                      4
 :func:`tracks`                the four stages of Fig. 18 / Table 2               3
-:func:`network`               every route and direction, their profiles           2
-:func:`pareto`                the risk–transport front of Fig. 21                 1
+:func:`network`               every route and direction, a profile row per route  2
+:func:`pareto`                the risk–transport fronts of Fig. 21 (axis cut)     1
 :func:`gantt`                 one schedule per aircraft (Eqs. 24–28)              1
 :func:`delays`                delay per flight and solver (Fig. 19)               1
-:func:`sweep`                 a sensitivity study from results.parquet (Sec. 6.3)  1–4
+:func:`sweep`                 a study, or any sweep (x, hue, y), from results     1–12
 :func:`performance_profile`   Dolan–Moré profile of a benchmark table             1
 ============================  ==================================================  =========
 

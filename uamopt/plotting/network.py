@@ -1,8 +1,10 @@
 """Figure of the route network (Sec. 4.1.2): every route and direction over the cruise layer,
 and their altitude profiles.
 
-One colour per route, arrow heads for the direction of flight, the two directions of a route
-told apart by line style; the layering of Sec. 4.1.2 puts them on different cruise layers.
+One colour per route, named on the map beside the track; arrow heads for the direction of
+flight, the two directions of a route told apart by line style (the first listed solid, the way
+back dashed); the layering of Sec. 4.1.2 puts them on different cruise layers. The profiles are
+small multiples, one row per route, so that tracks flying the same layer do not hide each other.
 """
 
 from __future__ import annotations
@@ -16,6 +18,7 @@ from matplotlib import colors, patheffects
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
+from matplotlib.ticker import MaxNLocator
 
 from uamopt.plotting.geometry import (
     along_track_m,
@@ -26,8 +29,6 @@ from uamopt.plotting.geometry import (
 )
 from uamopt.plotting.style import (
     BAND_GREEN,
-    BAND_TEXT,
-    HALO,
     LEGEND_BELOW,
     NO_FLY,
     cell_image,
@@ -38,13 +39,18 @@ from uamopt.plotting.style import (
     layer_of,
     map_axes,
     no_fly_hatching,
+    panel_letter,
     panel_title,
     panels,
+    root_figure,
     vertiport_points,
 )
 
 SAFE_PALE = "#f7f7f5"  # free cells with R ≤ R_0
 UNSAFE_PALE = "#e3d3c3"  # free cells with R > R_0
+WAY_BACK = (0, (3.2, 1.6))  # the dash pattern of a route's second direction
+LABEL_MAX_CHARS = 9  # longer route names are numbered on the map, the key in (b)
+PROFILE_ROW_IN = 0.55  # least height of one route's profile row (in), gap included
 
 
 def _draw_direction_arrows(ax, waypoints: np.ndarray, colour, fractions=(0.3, 0.62)) -> None:
@@ -81,13 +87,52 @@ def _network_layout(field):
     return tall if is_tall(field) else wide
 
 
+def route_colours(n: int) -> list:
+    """One distinct colour per route: tab10 up to ten routes, else tab20's dark tones before its
+    light ones (so that neighbours in the list differ most)."""
+    if n <= 10:
+        return list(matplotlib.colormaps["tab10"].colors[:n])
+    tab20 = matplotlib.colormaps["tab20"].colors
+    order = list(tab20[0::2]) + list(tab20[1::2])
+    return [order[i % len(order)] for i in range(n)]
+
+
+def route_label(forward: str) -> str:
+    """"V1–V4" for the route "V1-V4" (an en dash between two end points), else the name."""
+    parts = forward.split("-")
+    return "–".join(parts) if len(parts) == 2 else forward
+
+
+def _label_positions(tracks: list[np.ndarray], avoid: list[tuple[float, float]], spacing: float) -> list[np.ndarray]:
+    """One label anchor per track: the point along it (from its middle outwards) farthest from
+    the labels already placed and from the ``avoid`` points, at least ``spacing`` m from them
+    when such a point exists."""
+    placed = [np.asarray(p, dtype=float) for p in avoid]
+    anchors = []
+    fractions = np.array([0.5, 0.42, 0.58, 0.34, 0.66, 0.26, 0.74, 0.18, 0.82])
+    for wp in tracks:
+        d = along_track_m(wp)
+        candidates = point_at(wp, fractions * d[-1]) if d[-1] > 0 else wp[:1, :2]
+        if placed:
+            gaps = np.min(np.linalg.norm(candidates[:, None, :] - np.asarray(placed)[None, :, :], axis=2), axis=1)
+            good = np.flatnonzero(gaps >= spacing)
+            choice = candidates[good[0]] if good.size else candidates[int(np.argmax(gaps))]
+        else:
+            choice = candidates[0]
+        placed.append(choice)
+        anchors.append(choice)
+    return anchors
+
+
 def network(model, routes, ax=None, *, vertiports: Iterable = (), title: str = "") -> Figure:
     """Draw a route network; return the Figure.
 
     (a) map over the cruise layer (pale: safe, tan: unsafe (Eq. 9), grey: buildings, red
-    hatching: no-fly), one colour per route, arrow heads for the direction of flight, the two
-    directions of a route solid and dashed; (b) altitude against horizontal distance flown for
-    every track: the layering of Sec. 4.1.2 shows as two cruise levels per route.
+    hatching: no-fly), one colour per route, named ("V1–V4") beside its track, arrow heads for
+    the direction of flight, the route's first direction solid and its way back dashed in the
+    same colour; (b) the altitude profiles, one row per route (both directions: altitude
+    against horizontal distance flown), on shared axes: the layering of Sec. 4.1.2 shows as
+    the two cruise levels of each route. Every legend lies inside the page.
 
     Parameters
     ----------
@@ -101,7 +146,8 @@ def network(model, routes, ax=None, *, vertiports: Iterable = (), title: str = "
         are drawn as one route.
     ax : None, Figure, Axes or sequence of 2 Axes
         None: a new 14 × 8 in page with (a) and (b); a Figure or SubFigure: that page in it; one
-        Axes: the map (a) only; two Axes: (a) and (b).
+        Axes: the map (a) only; two Axes: (a) and (b) (the rows of (b) are inset axes of the
+        second, its ``child_axes``, one per route in the order of the map's legend).
     vertiports : iterable
         As for :func:`uamopt.plotting.risk`: objects with ``name``, ``x``, ``y`` or tuples.
     title : str
@@ -119,58 +165,92 @@ def network(model, routes, ax=None, *, vertiports: Iterable = (), title: str = "
     g = field.grid
     k = layer_of(field, model.scenario.network.cruise_altitude_m)
     pairs = pair_directions(tracks_m, 2.0 * math.hypot(*g.cell[:2]))
-    palette = matplotlib.colormaps["tab10" if len(pairs) <= 10 else "tab20"].colors
+    palette = route_colours(len(pairs))
     fig, axes, page = panels(ax, 2, _network_layout(field))
     ax_map, ax_prof = axes[0], (axes[1] if len(axes) > 1 else None)
     _muted_layer(ax_map, field, k)
     map_axes(ax_map, field)
-    handles = []
-    for n, (forward, reverse) in enumerate(pairs):
-        colour = palette[n % len(palette)]
-        # the way back: a darker dashed line over the way out, so both show where they overlap
-        dark = tuple(0.6 * np.asarray(colors.to_rgb(colour)))
-        for name, style, c, lw in ((forward, "-", colour, 2.6), (reverse, (0, (3, 1.8)), dark, 1.3)):
+    for (forward, reverse), colour in zip(pairs, palette):
+        for name, style, lw in ((forward, "-", 2.6), (reverse, WAY_BACK, 1.5)):
             if name is None:
                 continue
             wp = tracks_m[name]
-            halo = [patheffects.withStroke(linewidth=lw + 1.8, foreground="white")] if style == "-" else []
-            ax_map.plot(wp[:, 0], wp[:, 1], color=c, lw=lw, ls=style, zorder=6 if style == "-" else 7,
-                        solid_capstyle="round", path_effects=halo)
-            _draw_direction_arrows(ax_map, wp, c)
-            if ax_prof is not None:
-                ax_prof.plot(along_track_m(wp), wp[:, 2], color=c, lw=1.6 if style == "-" else 1.3, ls=style)
-        text = f"{forward} ({cruise_altitude_m(tracks_m[forward]):.0f} m)"
-        if reverse is not None:
-            text += f" / {reverse} ({cruise_altitude_m(tracks_m[reverse]):.0f} m, dashed)"
-        handles.append(Line2D([], [], color=colour, lw=2.4, label=text))
-    draw_vertiports(ax_map, vertiport_points(vertiports))
+            # a white edge: the dashed way back reads over the solid way out where they overlap
+            halo = [patheffects.withStroke(linewidth=lw + (1.8 if style == "-" else 1.4), foreground="white")]
+            ax_map.plot(wp[:, 0], wp[:, 1], color=colour, lw=lw, ls=style, zorder=6 if style == "-" else 7,
+                        solid_capstyle="round", path_effects=halo, label=name)
+            _draw_direction_arrows(ax_map, wp, colour)
+    ports = vertiport_points(vertiports)
+    draw_vertiports(ax_map, ports)
+    # beside each route its name, or its number in (b) when names are long (real vertiport names)
+    names = [route_label(f) for f, _ in pairs]
+    keyed = ax_prof is not None and max(len(t) for t in names) > LABEL_MAX_CHARS
+    span = max(g.extent[:2])
+    avoid = [(x, y) for _, x, y in ports] + [(x + 0.06 * span, y + 0.02 * span) for _, x, y in ports]
+    anchors = _label_positions([tracks_m[f] for f, _ in pairs], avoid, 0.09 * span)
+    for n, (text, colour, (x, y)) in enumerate(zip(names, palette, anchors)):
+        ax_map.annotate(str(n + 1) if keyed else text, (x, y), ha="center", va="center", fontsize=6.5, fontweight="bold",
+                        color=tuple(0.75 * np.asarray(colors.to_rgb(colour))), zorder=9,
+                        bbox={"boxstyle": "round,pad=0.18", "fc": "white", "ec": colour, "lw": 0.8, "alpha": 0.9})
     z0, z1 = k * g.cell[2], (k + 1) * g.cell[2]
-    panel_title(ax_map, f"(a) routes over layer k={k}: z = {z0:g}–{z1:g} m")
+    letter = "(a)" if ax_prof is not None or page is not None else panel_letter(ax_map)
+    panel_title(ax_map, f"{letter} routes over layer k={k}: z = {z0:g}–{z1:g} m")
     ax_map.legend(handles=[Patch(facecolor=SAFE_PALE, edgecolor="0.6", label="R ≤ R₀"),
                            Patch(facecolor=UNSAFE_PALE, label="R > R₀ (Eq. 9)"),
                            Patch(facecolor="#9a9a9a", label="building"),
-                           Patch(facecolor="none", edgecolor=NO_FLY, hatch="////", label="no-fly")],
-                  **{**LEGEND_BELOW, "ncol": 4})
+                           Patch(facecolor="none", edgecolor=NO_FLY, hatch="////", label="no-fly"),
+                           Line2D([], [], color="0.2", lw=2.2, label="a route's first direction"),
+                           Line2D([], [], color="0.2", lw=1.4, ls=WAY_BACK, label="its way back")],
+                  **{**LEGEND_BELOW, "ncol": 3})
     if ax_prof is not None:
-        _network_profiles(ax_prof, field, handles)
+        _network_profiles(ax_prof, field, pairs, tracks_m, palette, keyed)
     finish(page, axes, field, f"{title + ' — ' if title else ''}route network: {len(tracks_m)} tracks on "
                               f"{len(pairs)} routes; cells {g.cell[0]:g} × {g.cell[1]:g} × {g.cell[2]:g} m")
     return fig
 
 
-def _network_profiles(ax, field, handles) -> None:
+def _network_profiles(ax, field, pairs, tracks_m, palette, keyed: bool = False) -> None:
+    """Panel (b): ``ax`` becomes a frame holding one inset row per route (its ``child_axes``),
+    all on the same distance and altitude scales; ``keyed``: each row's title starts with the
+    number that names the route on the map."""
     g = field.grid
     low, high = field.band
-    for level in (low, high):
-        ax.axhline(level, color=BAND_GREEN, lw=1.2, ls="--")
-    ax.annotate(f"band {low:g}–{high:g} m (Eq. 14)", (1.0, high), xycoords=("axes fraction", "data"),
-                xytext=(-3, -2), textcoords="offset points", ha="right", va="top", fontsize=7, color=BAND_TEXT,
-                path_effects=HALO)
-    ax.set_ylim(0.0, min(high + 2 * g.cell[2], g.extent[2]))
-    ax.set_xlim(0.0, None)
-    ax.set_xlabel("horizontal distance flown (m)", fontsize=8)
-    ax.set_ylabel("altitude z (m)", fontsize=8)
-    ax.tick_params(labelsize=7)
-    ax.legend(handles=handles, fontsize=7, loc="lower center", ncol=2, framealpha=0.9,
-              title="route: direction (cruise altitude)", title_fontsize=7)
-    panel_title(ax, "(b) vertical profiles: solid and dashed are the two directions of a route")
+    n = len(pairs)
+    dpi = root_figure(ax).dpi
+    height_in = max(ax.bbox.height / dpi, 1e-3)
+    ncols = int(min(max(math.ceil(n * PROFILE_ROW_IN / height_in), 1), 4, n))
+    nrows = math.ceil(n / ncols)
+    every = np.concatenate([w[:, 2] for w in tracks_m.values()])
+    z_lo, z_hi = float(every.min()) - g.cell[2], float(every.max()) + g.cell[2]
+    d_max = max(float(along_track_m(w)[-1]) for w in tracks_m.values()) or 1.0
+    levels = sorted({round(cruise_altitude_m(w)) for w in tracks_m.values()})
+    ticks = levels if len(levels) <= 4 else MaxNLocator(4).tick_values(z_lo, z_hi)
+    ax.set_axis_off()
+    wgap, hgap = 0.04 if ncols > 1 else 0.0, 0.16 / height_in  # axes fractions: room for each row's name
+    width, height = (1.0 - wgap * (ncols - 1)) / ncols, (1.0 - hgap * nrows) / nrows
+    for i, ((forward, reverse), colour) in enumerate(zip(pairs, palette)):
+        r, c = i % nrows, i // nrows  # down the first column, then the next
+        row = ax.inset_axes([c * (width + wgap), 1.0 - (r + 1) * (height + hgap), width, height])
+        for name, style in ((forward, "-"), (reverse, WAY_BACK)):
+            if name is not None:
+                wp = tracks_m[name]
+                row.plot(along_track_m(wp), wp[:, 2], color=colour, lw=1.6 if style == "-" else 1.3, ls=style,
+                         label=name)
+        for level in (low, high):
+            if z_lo < level < z_hi:
+                row.axhline(level, color=BAND_GREEN, lw=0.9, ls="--")
+        row.set_xlim(0.0, d_max)
+        row.set_ylim(z_lo, z_hi)
+        row.set_yticks(ticks)
+        row.grid(axis="y", color="0.88", lw=0.6)
+        row.tick_params(labelsize=6, length=2, pad=1, labelbottom=r == nrows - 1 or i == n - 1)
+        text = (f"{i + 1}: " if keyed else "") + f"{forward} (solid)" + (f", {reverse} (dashed)" if reverse else "")
+        row.set_title(text, fontsize=6.5, loc="left", y=1.0, pad=1.5, color=tuple(0.75 * np.asarray(colors.to_rgb(colour))),
+                      fontweight="bold")
+        if r == nrows - 1 or i == n - 1:
+            row.set_xlabel("horizontal distance flown (m)", fontsize=7, labelpad=1)
+    ax.text(-0.055 if ncols == 1 else -0.07, 0.5, "altitude z (m)", transform=ax.transAxes, rotation=90,
+            ha="center", va="center", fontsize=8)
+    shown = z_lo < low < z_hi or z_lo < high < z_hi
+    panel_title(ax, f"(b) altitude profile of every track, one row per route; band {low:g}–{high:g} m (Eq. 14)"
+                    + (" dashed green" if shown else ""))

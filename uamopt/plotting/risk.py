@@ -55,6 +55,7 @@ from uamopt.plotting.style import (
     map_axes,
     mark_threshold,
     outline,
+    panel_letter,
     panel_title,
     panels,
     risk_cmap,
@@ -107,7 +108,7 @@ def _draw_section_line(ax, y: float, xmax: float) -> None:
                 path_effects=HALO, zorder=7)
 
 
-def _panel_risk_map(ax, field, k, norm, cmap, ports, section_y):
+def _panel_risk_map(ax, field, k, norm, cmap, ports, section_y, letter="(a)"):
     g = field.grid
     image = draw_risk_layer(ax, field, k, norm, cmap)
     map_axes(ax, field)
@@ -115,7 +116,7 @@ def _panel_risk_map(ax, field, k, norm, cmap, ports, section_y):
         _draw_section_line(ax, section_y, g.extent[0])
     draw_vertiports(ax, ports)
     z0, z1 = k * g.cell[2], (k + 1) * g.cell[2]
-    panel_title(ax, f"(a) risk R (Eq. 8) on layer k={k}, z = {z0:g}–{z1:g} m")
+    panel_title(ax, f"{letter} risk R (Eq. 8) on layer k={k}, z = {z0:g}–{z1:g} m")
     cbar = ax.figure.colorbar(image, cax=colorbar_axes(ax))
     mark_threshold(cbar, field)
     handles = [Patch(facecolor=OBSTACLE_GREY, label="building (obstacle)"),
@@ -269,7 +270,9 @@ def risk(field, ax=None, *, vertiports: Iterable = (), cruise_altitude_m: float 
     ax : None, Figure, Axes or sequence of 5 Axes
         None: a new 14 × 8 in page with panels (a)–(e) (module docstring), a title and the data
         credit. A Figure or SubFigure: that page laid out in it. One Axes: map (a) only, with
-        its colour bar and legend, the credit in its corner. Five Axes: panels (a)–(e) in them.
+        its colour bar and legend, the credit in its corner, lettered by its place among the
+        figure's panels (three maps in ``fig.subplots(1, 3)`` are (a), (b), (c)). Five Axes:
+        panels (a)–(e) in them.
     vertiports : iterable
         Objects with ``name``, ``x``, ``y`` (m), e.g. ``scenario.network.vertiports``, or
         ``(name, x, y)`` tuples; drawn as labelled markers.
@@ -303,7 +306,7 @@ def risk(field, ax=None, *, vertiports: Iterable = (), cruise_altitude_m: float 
     norm, cmap = risk_norm(field), risk_cmap()
     fig, axes, page = panels(ax, 5, _layout(field))
     if len(axes) == 1:
-        _panel_risk_map(axes[0], field, k, norm, cmap, ports, None)
+        _panel_risk_map(axes[0], field, k, norm, cmap, ports, None, panel_letter(axes[0]))
         finish(None, axes, field, "")
         return fig
     ax_a, ax_b, ax_c, ax_d, ax_e = axes
@@ -314,13 +317,14 @@ def risk(field, ax=None, *, vertiports: Iterable = (), cruise_altitude_m: float 
     _panel_unsafe_share(ax_e, field)
     if ax_e.get_shared_y_axes().joined(ax_d, ax_e):
         ax_e.tick_params(labelleft=False)
-    in_band = field.unsafe[:, :, field.band_layers()]
     head = f"{title} — " if title else ""
-    band_text = f", {in_band.mean():.1%} in the band {field.band[0]:g}–{field.band[1]:g} m" if in_band.size else ""
+    # the report's figure (summary()["band_unsafe_share"]): obstacle cells are in neither count
+    band_text = (f", {field.unsafe_share():.1%} of the band's free cells ({field.band[0]:g}–{field.band[1]:g} m)"
+                 if field.band_layers().size else "")
     finish(page, axes, field,
            f"{head}city: {field.city.source}; cells {g.cell[0]:g} × {g.cell[1]:g} × {g.cell[2]:g} m "
-           f"({nx} × {ny} × {nz}); unsafe (Eq. 9, R > R₀ = {field.threshold:.0e} per flight hour, "
-           f"buildings, no-fly): {field.unsafe.mean():.1%} of cells{band_text}")
+           f"({nx} × {ny} × {nz}); unsafe (Eq. 9: R > R₀ = {field.threshold:.0e}/h, buildings, no-fly): "
+           f"{field.unsafe.mean():.1%} of all cells{band_text}")
     return fig
 
 

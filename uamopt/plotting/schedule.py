@@ -24,6 +24,16 @@ def _route_key(route: str) -> str:
     return "-".join(sorted(route.split("-")))
 
 
+def objective_text(problem) -> str:
+    """The objective a schedule was optimised for, as the scheduling figures' titles name it
+    (``problem.objective_kind``)."""
+    if problem.objective_kind == "lexicographic":
+        return "objective lexicographic: most flights, then least delay"
+    if problem.objective_kind == "weighted":
+        return "objective Eq. 20 weighted"
+    return f"objective {problem.objective_kind}"
+
+
 def gantt(problem, schedule, ax=None, *, title: str = "") -> Figure:
     """One row per aircraft: each operated flight from departure to arrival (colour: route), its
     delay d_f as a red line from the planned departure D_f, cancelled flights as hatched outlines
@@ -37,7 +47,8 @@ def gantt(problem, schedule, ax=None, *, title: str = "") -> Figure:
     ax : None, Figure or Axes
         None: a new figure 14 in wide, 0.32 in per aircraft; a Figure: one Axes filling it.
     title : str
-        Replaces the default title (solver, operated, cancelled, total delay).
+        Replaces the leading part of the title (solver, operated, cancelled, total delay); the
+        objective (:func:`objective_text`) always follows it.
 
     Returns
     -------
@@ -57,6 +68,8 @@ def gantt(problem, schedule, ax=None, *, title: str = "") -> Figure:
     delay = np.asarray(schedule.delay_s, dtype=float)
     on = np.asarray(schedule.operated, dtype=bool)
     y = np.array([row[f.aircraft] for f in flights], dtype=float)
+    default = (f"{schedule.solver}: {schedule.operated_count} operated, {schedule.cancelled} cancelled, "
+               f"total delay {schedule.total_delay_s:.0f} s")
     fig, ax, _ = single_axes(ax, (14.0, max(4.0, 0.32 * len(aircraft) + 1.5)))
     ax.barh(y[on], duration[on], left=(planned + delay)[on], height=0.6,
             color=[colour[k] for k, o in zip(keys, on) if o], edgecolor="black", linewidth=0.3)
@@ -74,8 +87,7 @@ def gantt(problem, schedule, ax=None, *, title: str = "") -> Figure:
     handles += [Patch(fill=False, hatch="///", edgecolor="grey", label="cancelled (planned slot)"),
                 Patch(color=DELAY_RED, label="delay")]
     ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=8, frameon=False)
-    ax.set_title(title or f"{schedule.solver}: {schedule.operated_count} operated, {schedule.cancelled} cancelled, "
-                 f"total delay {schedule.total_delay_s:.0f} s", y=1.0)
+    ax.set_title(f"{title or default} — {objective_text(problem)}", y=1.0)
     return fig
 
 
@@ -91,7 +103,9 @@ def delays(problem, schedules: Mapping, ax=None, *, title: str = "") -> Figure:
     ax : None, Figure or Axes
         None: a new 14 × 5.5 in figure; a Figure: one Axes filling it.
     title : str
-        Replaces the default title.
+        Replaces the leading part of the title ("delay per flight, by solver"); the objective
+        (:func:`objective_text`: "Eq. 20 weighted" or "lexicographic: most flights, then least
+        delay") always follows it, so that the figures of the two objectives are told apart.
 
     Returns
     -------
@@ -114,6 +128,6 @@ def delays(problem, schedules: Mapping, ax=None, *, title: str = "") -> Figure:
         ax.bar(x[~on], problem.delay_upper_s[idx][~on], width=width, fill=False, edgecolor=cmap(n), hatch="..")
     ax.set_xticks(np.arange(len(idx)), [ids[i] for i in idx], rotation=90, fontsize=6)
     ax.set_ylabel("delay d (s); hollow: cancelled (drawn at Δd)")
-    ax.set_title(title or "delay per flight, by solver (Fig. 19 analogue)", y=1.0)
+    ax.set_title(f"{title or 'delay per flight, by solver (Fig. 19 analogue)'} — {objective_text(problem)}", y=1.0)
     ax.legend(fontsize=8)
     return fig

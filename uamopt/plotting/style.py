@@ -402,6 +402,16 @@ def draw_vertiports(ax: Axes, ports: list[tuple[str, float, float]]) -> None:
                     fontweight="bold", zorder=7, path_effects=HALO)
 
 
+def panel_letter(ax: Axes) -> str:
+    """The letter of a map drawn alone into an Axes the caller passed: its place among the
+    panels of its figure, "(a)", "(b)", "(c)" for ``fig.subplots(1, 3)`` (the order they were
+    created in; colour bars are not panels), so that maps drawn side by side are told apart.
+    A page a plot function lays out itself letters its panels in its own order instead."""
+    siblings = [a for a in ax.figure.axes if a.get_label() != "<colorbar>"]
+    n = next((i for i, a in enumerate(siblings) if a is ax), 0)
+    return f"({chr(ord('a') + n)})" if n < 26 else f"({n + 1})"
+
+
 def panel_title(ax: Axes, text: str, fontsize: float = 9) -> None:
     """A left-aligned panel title at a fixed height (y = 1 skips matplotlib's search for tick
     labels above the axes, which is costly and finds none here)."""

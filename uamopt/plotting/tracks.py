@@ -17,7 +17,7 @@ origin–destination pair (Sec. 6.3.2, Fig. 21).
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping
 
 import numpy as np
 from matplotlib import patheffects
@@ -50,6 +50,7 @@ from uamopt.plotting.style import (
     map_axes,
     mark_threshold,
     outline,
+    panel_letter,
     panel_title,
     panels,
     risk_cmap,
@@ -104,7 +105,7 @@ def _draw_margin(ax, model, k: int, window) -> None:
 # --- the tracks page --------------------------------------------------------------------------
 
 
-def _panel_map(ax, model, plan, norm, cmap, window):
+def _panel_map(ax, model, plan, norm, cmap, window, letter="(a)"):
     field = model.field
     k = layer_of(field, plan.origin[2])
     image = draw_risk_layer(ax, field, k, norm, cmap)
@@ -118,7 +119,7 @@ def _panel_map(ax, model, plan, norm, cmap, window):
         ax.annotate("(b)", (x0, y1), xytext=(2, 2), textcoords="offset points", fontsize=8, fontweight="bold",
                     path_effects=HALO, zorder=9)
     z0, z1 = k * field.grid.cell[2], (k + 1) * field.grid.cell[2]
-    panel_title(ax, f"(a) tracks over R (Eq. 8), layer k={k}: z = {z0:g}–{z1:g} m")
+    panel_title(ax, f"{letter} tracks over R (Eq. 8), layer k={k}: z = {z0:g}–{z1:g} m")
     mark_threshold(ax.figure.colorbar(image, cax=colorbar_axes(ax)), field)
 
 
@@ -238,7 +239,7 @@ def tracks(plan, model, ax=None, *, title: str = "") -> Figure:
     fig, axes, page = panels(ax, 3, _tracks_layout(field))
     tall = is_tall(field)
     window = None if len(axes) == 1 else detour_window(plan, field, aspect=2.4 if tall else max(g.extent[0] / g.extent[1], 1.0))
-    _panel_map(axes[0], model, plan, norm, cmap, window)
+    _panel_map(axes[0], model, plan, norm, cmap, window, "(a)" if window is not None else panel_letter(axes[0]))
     if window is not None:
         _panel_zoom(axes[1], model, plan, norm, cmap, window)
         _panel_profile(axes[2], model, plan)
@@ -263,54 +264,159 @@ def tracks(plan, model, ax=None, *, title: str = "") -> Figure:
 
 # --- the Pareto front -------------------------------------------------------------------------
 
+SERIES_STYLE = (("#1f4e9c", "o"), ("#7b3294", "s"), ("#1b7837", "^"), ("#8c510a", "D"))  # colour, marker
+FOCUS_SHARE = 0.2  # a group of points narrower than this share of the axis range gets the axis to itself
+TINY_WEIGHT = 1e-6  # weights below this are the sweep's tie-break ε, not a weighting
 
-def pareto(points: Sequence, ax=None, *, plan=None, title: str = "") -> Figure:
+
+def focus_range(values) -> tuple[float, float] | None:
+    """(lo, hi) of the main group of ``values`` when the rest lie so far off that the group
+    would fill less than a fifth of an axis spanning them all (Fig. 21's ω4 = 1 track at ¥124
+    against eight tracks at ¥29–31); None when one axis shows them all well. The main group is
+    the larger side of the widest gap between sorted values (the lower side on a tie).
+
+    >>> focus_range([29.3, 29.4, 30.2, 30.9, 123.6])
+    (29.3, 30.9)
+    >>> focus_range([1.0, 2.0, 3.0]) is None
+    True
+    """
+    v = np.sort(np.asarray([x for x in values if np.isfinite(x)], dtype=float))
+    if v.size < 2 or v[-1] == v[0]:
+        return None
+    i = int(np.argmax(np.diff(v)))
+    low, high = v[:i + 1], v[i + 1:]
+    main = low if low.size >= high.size else high
+    if main[-1] - main[0] >= FOCUS_SHARE * (v[-1] - v[0]):
+        return None
+    return float(main[0]), float(main[-1])
+
+
+def _weights_text(p) -> str:
+    """The point's risk weight ω4 / (ω4 + ω5) (a weighted sum is unchanged by scaling both);
+    ε when it is the sweep's tie-break (below 10⁻⁶)."""
+    w = p.w4 / (p.w4 + p.w5)
+    return "ω4 = ε" if w < TINY_WEIGHT else f"ω4 = {w:.2g}"
+
+
+BREAK_AT = 0.83  # axes fraction where the main part of a broken x axis ends
+OUTLIERS_FROM = 0.86  # and where the part beyond the break starts
+
+
+def _break_marks(ax) -> None:
+    """Short diagonal strokes on the top and bottom edges at both sides of the cut."""
+    for x in (BREAK_AT, OUTLIERS_FROM):
+        for y in (0.0, 1.0):
+            ax.plot([x - 0.006, x + 0.006], [y - 0.015, y + 0.015], transform=ax.transAxes, color="black", lw=1.0,
+                    clip_on=False, zorder=11)
+
+
+def pareto(points, ax=None, *, plan=None, title: str = "") -> Figure:
     """Draw the trade-off of Fig. 21 (8 × 5.5 in when ``ax`` is None); return the Figure.
 
     ``points`` (ParetoPoint) may hold a whole :func:`uamopt.planning.pareto.weight_sweep`: the
-    non-dominated ones form the front (line and markers, each labelled with its (ω4, ω5)), the
-    others are greyed. With ``plan``, its four stages (Table 2) are marked in the colours of
-    Fig. 18 for comparison. ``ax``: None, a Figure or one Axes.
+    non-dominated ones form the front (line and markers, each labelled with its risk weight
+    ω4 / (ω4 + ω5), ε for the sweep's tie-break), the others are greyed. A mapping of series
+    name to such points draws several sweeps, one colour and marker each, with a legend, e.g.
+    the two that the report tables::
+
+        pareto({"Eq. 10 (μ = 0)": weight_sweep(model, a, b, buffer=False),
+                "Eq. 10 + μ·R(t)": weight_sweep(model, a, b)})
+
+    When a few points lie so far off that the others would crowd into less than a fifth of the
+    transport-cost axis (the ω4 = 1 track at ¥124 against eight at ¥29–31, see
+    :func:`focus_range`), the axis is broken: the Axes shows the main group, and a narrow
+    panel at its right (an inset, ``ax.child_axes[0]``, sharing the risk axis) the points
+    beyond the cut on their own scale, with break marks between. With ``plan``, its four stages
+    (Table 2) are marked in the colours of Fig. 18 for comparison. ``ax``: None, a Figure or
+    one Axes.
 
     Raises
     ------
     ValueError
-        ``points`` is empty.
+        ``points`` is empty (or a series of the mapping is).
     """
     from uamopt.planning.pareto import (
         non_dominated,  # the planning stage, loaded when a front is drawn
     )
 
-    if not points:
-        raise ValueError("points must hold at least one ParetoPoint")
-    front = non_dominated(points)
-    on_front = {id(p) for p in front}
-    rest = [p for p in points if id(p) not in on_front]
+    series = dict(points) if isinstance(points, Mapping) else {"": list(points)}
+    if not series or any(not list(v) for v in series.values()):
+        raise ValueError("points must hold at least one ParetoPoint (in every series)")
+    several = len(series) > 1
     fig, ax, _ = single_axes(ax, (8.0, 5.5))
-    if rest:
-        ax.scatter([p.transport_cost for p in rest], [p.risk_cost for p in rest], s=28, c="0.7",
-                   edgecolors="0.45", linewidths=0.6, zorder=3, label="dominated")
-    ax.plot([p.transport_cost for p in front], [p.risk_cost for p in front], color="#1f4e9c", lw=1.4,
-            marker="o", ms=6, mfc="white", mew=1.4, zorder=4,
-            label=f"Pareto front ({len(front)} track{'s' if len(front) > 1 else ''})")
-    if plan is not None:
-        for name, marker in zip(STAGES, "sDPo"):
-            st = plan.stages[name]
-            ax.scatter([st.transport_cost], [st.risk_cost], marker=marker, s=55, c=STAGE_STYLE[name][1],
-                       edgecolors="black", linewidths=0.7, zorder=5, label=f"{name} track (Table 2)")
-    ax.margins(x=0.12, y=0.08)
+    stages = [(name, marker, plan.stages[name]) for name, marker in zip(STAGES, "sDPo")] if plan is not None else []
+    every = [p for pts in series.values() for p in pts]
+    costs = [p.transport_cost for p in every] + [st.transport_cost for _, _, st in stages]
+    focus = focus_range(costs)
+    fronts = {name: non_dominated(list(pts)) for name, pts in series.items()}
+
+    def draw(target, lo: float, hi: float, above: bool) -> None:
+        """Every series and stage into ``target``; weight labels for the points in [lo, hi],
+        beside them or (``above``, in the narrow panel beyond a cut) above them."""
+        middle = 0.5 * (lo + hi)
+        labelled: dict = {}  # (C_T, C_R) → labels already there: the same track of another series
+        for n, (name, pts) in enumerate(series.items()):
+            colour, marker = SERIES_STYLE[n % len(SERIES_STYLE)]
+            front = fronts[name]
+            on_front = {id(p) for p in front}
+            rest = [p for p in pts if id(p) not in on_front]
+            if rest:
+                target.scatter([p.transport_cost for p in rest], [p.risk_cost for p in rest], s=28, marker=marker,
+                               c="0.75" if not several else "none", edgecolors="0.45" if not several else colour,
+                               linewidths=0.6, zorder=3, label=f"dominated ({name})" if several else "dominated")
+            target.plot([p.transport_cost for p in front], [p.risk_cost for p in front], color=colour, lw=1.4,
+                        marker=marker, ms=6, mfc="white", mew=1.4, zorder=4,
+                        label=f"{name + ': ' if several else ''}Pareto front ({len(front)} "
+                              f"track{'s' if len(front) > 1 else ''})")
+            for p in front:  # labels point inwards, away from the axes' edges
+                if not lo <= p.transport_cost <= hi:
+                    continue
+                left = p.transport_cost > middle
+                key = (round(p.transport_cost, 6), round(p.risk_cost, 6))
+                shift = 7.5 * labelled.get(key, 0)  # a second series' label beside the first, not on it
+                labelled[key] = labelled.get(key, 0) + 1
+                place = ({"xytext": (shift, 7), "ha": "center", "va": "bottom", "rotation": 90} if above else
+                         {"xytext": (-8 if left else 8, -shift), "ha": "right" if left else "left", "va": "center"})
+                target.annotate(_weights_text(p), (p.transport_cost, p.risk_cost), textcoords="offset points",
+                                fontsize=6.5, color=colour, zorder=6, **place)
+        for name, marker, st in stages:
+            target.scatter([st.transport_cost], [st.risk_cost], marker=marker, s=55, c=STAGE_STYLE[name][1],
+                           edgecolors="black", linewidths=0.7, zorder=5, label=f"{name} track (Table 2)")
+
+    lo, hi = focus if focus is not None else (min(costs), max(costs))
+    pad = 0.08 * (hi - lo) if hi > lo else max(0.02 * abs(hi), 1e-9)
+    draw(ax, lo, hi, False)
+    ax.margins(y=0.08)
     ax.autoscale_view()
-    middle = 0.5 * sum(ax.get_xlim())
-    for p in front:  # labels point inwards, away from the axes' edges
-        left = p.transport_cost > middle
-        ax.annotate(f"(ω4, ω5) = ({p.w4:.2g}, {p.w5:.2g})", (p.transport_cost, p.risk_cost),
-                    xytext=(-7 if left else 7, 0), textcoords="offset points", fontsize=6.5, color="#1f4e9c",
-                    va="center", ha="right" if left else "left", zorder=6)
-    ax.set_xlabel("transport cost C_T (¥, Eq. 12)", fontsize=9)
+    if focus is None:
+        ax.set_xlim(lo - pad, hi + pad)
+        legend_anchor = {}
+    else:
+        # the main group on the left BREAK_AT of the axes; beyond the cut, an inset on its own scale
+        x0, x1 = lo - pad, hi + pad
+        ax.set_xlim(x0, x0 + (x1 - x0) / BREAK_AT)
+        ax.set_xticks([t for t in MaxNLocator(6).tick_values(x0, x1) if x0 <= t <= x1])
+        for side in ("top", "bottom"):
+            ax.spines[side].set_bounds(x0, x1)
+        ax.spines["right"].set_visible(False)
+        far = [c for c in costs if c > x1 or c < x0]
+        f0, f1 = min(far), max(far)
+        fpad = 0.15 * (f1 - f0) if f1 > f0 else max(0.03 * abs(f1), 1e-9)
+        beyond = ax.inset_axes([OUTLIERS_FROM, 0.0, 1.0 - OUTLIERS_FROM, 1.0], sharey=ax, zorder=9)
+        draw(beyond, f0 - fpad, f1 + fpad, True)
+        beyond.set_xlim(f0 - fpad, f1 + fpad)
+        beyond.xaxis.set_major_locator(MaxNLocator(2))
+        beyond.spines["left"].set_visible(False)
+        beyond.tick_params(labelsize=8, left=False, labelleft=False)
+        beyond.grid(color="0.9", lw=0.6)
+        _break_marks(ax)
+        legend_anchor = {"bbox_to_anchor": (BREAK_AT - 0.01, 1.0)}
+    ax.set_xlabel("transport cost C_T (¥, Eq. 12)" + ("; the axis is cut (//)" if focus is not None else ""),
+                  fontsize=9)
     ax.set_ylabel("operational risk cost C_R (Eq. 11)", fontsize=9)
     ax.tick_params(labelsize=8)
     ax.grid(color="0.9", lw=0.6)
-    ax.legend(fontsize=7.5, loc="best", framealpha=0.9)
-    ax.set_title(f"{title + ' — ' if title else ''}trade-off between operational risk and transport cost (Fig. 21)",
+    ax.legend(fontsize=7.5, loc="upper right", framealpha=0.9, **legend_anchor).set_zorder(12)
+    ax.set_title(f"{title + ' — ' if title else ''}operational risk against transport cost (Fig. 21)",
                  fontsize=10, y=1.0)
     return fig
