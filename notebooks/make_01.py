@@ -45,7 +45,7 @@ summary = field.summary()
 assert grid.shape == (50, 90, 12)  # 2500 × 4500 × 360 m in 50 × 50 × 30 m cells (Sec. 6.2)
 print(f"grid {grid.shape} cells of {grid.cell} m; city: {summary['source']}")
 print(f"altitude band (Eq. 14): {field.band} m; R_0 = {field.threshold:g} per flight hour")
-print(f"unsafe cells (Eq. 9): {summary['unsafe_share']:.1%}; in the band: {summary['band_unsafe_share']:.1%}")"""),
+print(f"unsafe cells (Eq. 9): {summary['unsafe_share']:.1%}; in the band: {summary['band_unsafe_share']:.1%} of its free cells (not in or below a building)")"""),
     md("""## 2 · The physics, checked through the field itself
 
 The paper prints no intermediate numbers for App. A; the project's reference numbers
@@ -231,7 +231,7 @@ assert not np.any(field.unsafe[in_air & no_road]), "a cell above open ground exc
 assert not np.any((city.road_length > 0) & (city.road_length <= road_min_m))  # no slivers in this city
 both_free = free[:, :, 1:] & free[:, :, :-1]
 assert np.all(field.risk[:, :, 1:][both_free] >= field.risk[:, :, :-1][both_free] * (1 - 1e-12))
-print(f"columns with a road: {(city.road_length > 0).mean():.1%}; unsafe in the band: {field.unsafe[:, :, band].mean():.1%}")"""),
+print(f"columns with a road: {(city.road_length > 0).mean():.1%}; unsafe in the band: {field.unsafe_share():.1%} of its free cells")"""),
     md("""## 5 · Fig. 20: the cruise altitude (100, 160, 220 m)
 
 The paper shows the airspace at 100, 160 and 220 m and states that *"a moderate increase in

@@ -222,7 +222,9 @@ assert all(abs(p.transport_cost - transport_cost(p.waypoints)) <= 1e-9 * p.trans
 assert costs[0, 1] <= costs[:, 1].min() + 1e-9 and costs[1, 0] <= costs[:, 0].min() + 1e-9  # the two extremes
 assert sum(not d for d in dominated) >= (3 if SMALL else 4)  # a front, not one point (the paper's Fig. 21)
 fig21"""),
-    code("""ua.plotting.pareto(points, plan=plan, title=f"P_O -> P_D at {TABLE2_CELL_M:g} m cells")"""),
+    code("""unbuffered = ua.weight_sweep(model, "V1", "V4", PARETO_SOLVES, buffer=False)  # the report's other series
+ua.plotting.pareto({"Eq. 10 (μ = 0)": unbuffered, "Eq. 10 + μ·R(t)": points}, plan=plan,
+                   title=f"P_O -> P_D at {TABLE2_CELL_M:g} m cells")"""),
     md("""The front bends as the paper's does: the first metres of risk avoided are cheap, the last ones
 dear. Our points are the initial tracks of each weighting (grid paths, the optimal tracks of Table 2
 marked for comparison); the paper does not say which stage its Fig. 21 shows. Each point's search

@@ -111,8 +111,8 @@ def reproduce(scenario: Scenario, out: str | Path, overrides: list[str] | None =
 
             plotting.save(plotting.tracks(plan, fine_model, title=f"{scenario.name}, {t2:g} m cells"),
                           stage / "tracks.png")
-            plotting.save(plotting.pareto(fronts[True], title=f"{scenario.name}: Eq. 10 + μ·R(t) trade-off"),
-                          stage / "pareto.png")
+            plotting.save(plotting.pareto({"Eq. 10 (μ = 0)": fronts[False], "Eq. 10 + μ·R(t)": fronts[True]},
+                                          title=scenario.name), stage / "pareto.png")
         provenance = schedule_provenance(scenario, list(overrides or []))
         sections = [risk_section(scenario, summary), table2_section(fine, fine_model, tracks, paper=paper),
                     table2_section(v_scenario, v_model, v_plan.as_dict(), figure=False, paper=paper,
