@@ -208,3 +208,67 @@ def test_low_patch_is_an_obstacle_but_not_a_clearance_source(dsm_dir):
     assert low.admissible[4, 7, 1] and not low.admissible[4, 7, 0]
     tall = model(2.0)  # the same 6 m surface counted as buildings: 10 m above is within s_min = 50 m
     assert tall.field.city.building_height[4, 7] == pytest.approx(6.0) and not tall.admissible[4, 7, 1]
+
+
+# --- the shipped example: models/dsm_example.toml ------------------------------------------------
+
+EXAMPLE = Path(__file__).resolve().parents[1] / "models" / "dsm_example.toml"
+
+
+def test_the_example_dsm_is_a_small_plausible_city():
+    """The shipped GeoTIFF is small, projected (UTM 33N) and 1.2 km × 1.0 km; at its 10 m cells it
+    has towers up to about 180 m, roads, a no-fly zone, and four vertiports that can be flown from."""
+    from uamopt.pipeline import compute_risk
+    from uamopt.planning import planning_model
+
+    data = EXAMPLE.parent / "data"
+    assert (data / "dsm_example.tif").stat().st_size <= 200_000
+    scenario = load_scenario(EXAMPLE)
+    assert dsm_extent(scenario) == (1200.0, 1000.0) and scenario.grid.cell == (10.0, 10.0, 10.0)
+    with rasterio.open(data / "dsm_example.tif") as src:
+        assert src.crs.to_epsg() == 32633 and src.crs.is_projected
+    field = compute_risk(scenario)
+    city = field.city
+    assert field.grid.shape == (120, 100, 30)
+    assert 170.0 <= city.building_height.max() <= 180.0
+    assert 0.3 < (city.building_height > 0).mean() < 0.7  # built-up blocks between streets and open ground
+    assert city.notes["roads"] > 10 and (city.road_length > 0).mean() > 0.1 and city.notes["no_fly_zones"] == 1
+    model = planning_model(scenario, field)
+    for v in scenario.network.vertiports:
+        cell = field.grid.index_of((v.x, v.y, scenario.network.cruise_altitude_m))
+        assert model.admissible[cell] and not field.unsafe[cell], v.name  # off the roads, clear of buildings
+
+
+def test_the_example_dsm_is_what_its_script_writes(tmp_path):
+    """models/data/make_dsm_example.py documents the shipped files: it writes the same raster and
+    GeoJSON."""
+    import importlib.util
+
+    script = EXAMPLE.parent / "data" / "make_dsm_example.py"
+    spec = importlib.util.spec_from_file_location("make_dsm_example", script)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    module.main(tmp_path)
+    for name in ("dsm_example_roads.geojson", "dsm_example_no_fly.geojson"):
+        assert json.loads((tmp_path / name).read_text()) == json.loads((script.parent / name).read_text()), name
+    with rasterio.open(tmp_path / "dsm_example.tif") as new, rasterio.open(script.parent / "dsm_example.tif") as old:
+        assert new.crs == old.crs and new.transform == old.transform
+        np.testing.assert_array_equal(new.read(1), old.read(1))
+
+
+def test_every_command_runs_on_the_example(tmp_path):
+    """`uamopt risk`, `plan`, `network` and `schedule` work on the shipped DSM scenario."""
+    from uamopt.cli import main
+
+    out = tmp_path / "out"
+    assert main(["risk", str(EXAMPLE), "--out", str(out / "risk")]) == 0
+    assert main(["plan", str(EXAMPLE), "--out", str(out / "plan")]) == 0
+    assert main(["network", str(EXAMPLE), "--out", str(out / "network")]) == 0
+    assert main(["schedule", str(EXAMPLE), "--solver", "greedy", "--network", str(out / "network" / "network.json"),
+                 "--out", str(out / "schedule")]) == 0
+    tracks = json.loads((out / "plan" / "tracks.json").read_text())
+    stages = tracks["stages"]
+    assert stages["optimal"]["risk_cost"] < stages["shortest"]["risk_cost"]
+    assert len(json.loads((out / "network" / "network.json").read_text())["routes"]) == 12
+    summary = json.loads((out / "schedule" / "summary.json").read_text())
+    assert summary["flights"] > 0 and (out / "schedule" / "schedule.csv").is_file()

@@ -117,11 +117,16 @@ def straight_segment_cost(scenario: Scenario, length_m: float = 4365.0) -> float
     return transport_rates(scenario)[0] * length_m
 
 
-def track_shape(tracks: dict, cruise_altitude_m: float, layer_m: float) -> dict:
+def track_shape(tracks: dict, cruise_altitude_m: float, layer_m: float, risk_tolerance: float = 0.02) -> dict:
     """The paper's Table 2 shape, per stage: does the track stay within one cell layer of the cruise
-    altitude, and how its C_T and C_R compare with the shortest track's (%)."""
+    altitude, how its C_T and C_R compare with the shortest track's (%), is it no riskier than the
+    shortest track (C_R), and (later stages) within (1 + ``risk_tolerance``) of the initial track's C_R
+    (or of the corridor's least risk from the exact end points plus that slack, when it is more)."""
     st = tracks["stages"]
     base = st["shortest"]
+    initial = st.get("initial", base)["risk_cost"]
+    least = st.get("equivalent", {}).get("least_risk")  # the corridor could not meet the bound (docs/readings.md)
+    bound = max((1 + risk_tolerance) * initial, (least or 0.0) + risk_tolerance * initial)
     shape = {}
     for name, stage in st.items():
         z = [p[2] for p in stage["waypoints"]]
@@ -130,8 +135,31 @@ def track_shape(tracks: dict, cruise_altitude_m: float, layer_m: float) -> dict:
             "max_altitude_deviation_m": deviation, "in_layer": deviation <= layer_m + 1e-6,
             "d_cost_pct": 100 * (stage["transport_cost"] / base["transport_cost"] - 1),
             "d_risk_pct": 100 * (stage["risk_cost"] / base["risk_cost"] - 1) if base["risk_cost"] else float("nan"),
+            "no_riskier": stage["risk_cost"] <= base["risk_cost"] * (1 + 1e-9) + 1e-12,
+            "within_initial": stage["risk_cost"] <= bound * (1 + 1e-6) + 1e-12,
         }
     return shape
+
+
+def risk_hint(scenario: Scenario, shape: dict) -> str:
+    """The variant (key and value) to try when a stage is riskier than the shortest track, or ""."""
+    t = scenario.tracks
+    if all(shape[n]["no_riskier"] for n in ("initial", "equivalent", "optimal")):
+        return ""
+    if not shape["initial"]["no_riskier"]:  # the search itself traded risk away
+        if t.risk_model == "continuous":
+            return ('the initial track is riskier: with tracks.risk_model = "continuous" C_R is tiny beside C_T; try '
+                    'tracks.risk_model = "binary" or raise ω4 in tracks.weights')
+        if t.buffer_measure != "structures":
+            return (f'the initial track is riskier: the buffer term of tracks.buffer_measure = "{t.buffer_measure}" '
+                    'outweighs risk; try tracks.buffer_measure = "structures" (the default)')
+        return ("the initial track is riskier: the safety-buffer term outweighs risk here; try a lower "
+                f"tracks.buffer_penalty (now {t.buffer_penalty:g}) or a larger ω4 in tracks.weights")
+    if t.equivalent == "midpoint":
+        return ('a later stage is riskier: the midpoint rule is not bounded by the initial track\'s risk; try '
+                'tracks.equivalent = "exact" (the default)')
+    return (f"a later stage is riskier: tracks.risk_tolerance = {t.risk_tolerance:g} lets it carry more than the "
+            'initial track; try tracks.risk_tolerance = 0, or tracks.equivalent = "exact_cost"')
 
 
 def table2_section(scenario: Scenario, model, tracks: dict, title: str = "Track planning: Table 2 analogue (Sec. 6.2, Fig. 18)",
@@ -152,8 +180,8 @@ def table2_section(scenario: Scenario, model, tracks: dict, title: str = "Track 
     g = model.field.grid
     o, d = tracks["origin"], tracks["destination"]
     cruise = scenario.network.cruise_altitude_m
-    shape = track_shape(tracks, cruise, g.cell[2])
     t = scenario.tracks
+    shape = track_shape(tracks, cruise, g.cell[2], t.risk_tolerance)
     lines = [
         f"## {title}",
         "",
@@ -178,11 +206,20 @@ def table2_section(scenario: Scenario, model, tracks: dict, title: str = "Track 
     stays = ", ".join(f"{n} {'yes' if shape[n]['in_layer'] else 'NO'} ({shape[n]['max_altitude_deviation_m']:.0f} m)"
                       for n in names)
     ini = shape["initial"]
+    later = ("initial", "equivalent", "optimal")
+    safer = ", ".join(f"{n} {'yes' if shape[n]['no_riskier'] else 'NO'} ({shape[n]['d_risk_pct']:+.1f} %)" for n in later)
+    kept = ", ".join(f"{n} {'yes' if shape[n]['within_initial'] else 'NO'}" for n in later[1:])
+    hint = risk_hint(scenario, shape)
+    least = st["equivalent"].get("least_risk")
     lines += [
         "",
         f"Shape checks: within one layer ({g.cell[2]:g} m) of the cruise altitude {cruise:g} m, largest deviation in "
         f"parentheses: {stays}. Initial track against the shortest: C_T {ini['d_cost_pct']:+.1f} %, "
         f"C_R {ini['d_risk_pct']:+.1f} %" + (" (paper: +20.6 %, −11.2 %)." if paper else "."),
+        f"No riskier than the shortest track (C_R): {safer}." + (f" Hint: {hint}." if hint else ""),
+        f"Later stages within {100 * t.risk_tolerance:g} % of the initial track's C_R (tracks.risk_tolerance): {kept}"
+        + (f" (the exact end points lie in risky cells: the bound is the least risk the corridor allows from them, "
+           f"{least:.1f}, plus the same slack; docs/readings.md)." if least is not None else "."),
         "The shortest track minimises C_T alone and breaks ties between equally cheap tracks by least risk. "
         "Waypoints: the shortest and initial tracks list their cell centres; the equivalent track's waypoints "
         "are its corners; the optimal track adds the points of its corner curves. Times are each stage's own"
@@ -192,7 +229,9 @@ def table2_section(scenario: Scenario, model, tracks: dict, title: str = "Track 
     mid = tracks.get("equivalent_midpoint_rule")
     eq = st["equivalent"]
     if mid:
-        lines += ["", f"Equivalent track, exact shortest polyline through the corridor (SOCP): {eq['length_m']:.1f} m, "
+        rule = {"exact Eq. 10 (SOCP)": "exact Eq. 10 optimum in the corridor (SOCP)",
+                "midpoint": "the paper's midpoint rule"}.get(eq.get("rule"), "exact shortest polyline through the corridor (SOCP)")
+        lines += ["", f"Equivalent track, {rule}: {eq['length_m']:.1f} m, "
                   f"¥{eq['transport_cost']:.4f}; the paper's midpoint rule: {mid['length_m']:.1f} m, ¥{mid['transport_cost']:.4f}."]
     if paper:
         lines += ["", f"Check of Eq. 12–13: a straight level 4365 m segment with m_p = {scenario.aircraft.payload_kg:g} kg "

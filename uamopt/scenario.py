@@ -280,6 +280,11 @@ class TracksConfig(_Section):
         "exact", description="equivalent track: exact shortest polyline in the corridor (SOCP), the corridor's "
         "exact Eq. 10 optimum (SOCP), or the paper's midpoint rule"
     )
+    risk_tolerance: NonNegFloat = Field(
+        0.02, description="the equivalent and optimal tracks carry at most (1 + this) × the initial track's risk "
+        "C_R (Eq. 11): a bound of the exact and exact_cost programs, kept by the smoothing (docs/readings.md); "
+        "the midpoint rule is not bounded"
+    )
     smoothing_m: NonNegFloat = Field(
         50.0, description="largest corner-rounding (fillet tangent) distance of the optimal track, m"
     )

@@ -3,7 +3,7 @@ equivalent track and smoothing. ``planning_model`` → ``plan_track`` / ``plan_n
 
 from uamopt.planning.problem import PlanningModel, planning_model
 from uamopt.planning.search import SearchProblem, SearchResult, grid_search
-from uamopt.planning.tracks import STAGES, TrackPlan, TrackStage, plan_track
+from uamopt.planning.tracks import STAGES, TrackPlan, TrackStage, TrackWeightsWarning, plan_track
 
 __all__ = ["PlanningModel", "STAGES", "SearchProblem", "SearchResult", "TrackPlan", "TrackStage",
-           "grid_search", "plan_track", "planning_model"]
+           "TrackWeightsWarning", "grid_search", "plan_track", "planning_model"]

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -26,7 +27,12 @@ import numpy as np
 
 from uamopt.errors import InputFileError, NoTrackError
 from uamopt.planning.problem import PlanningModel
-from uamopt.planning.tracks import TrackPlan, plan_track
+from uamopt.planning.tracks import (
+    TrackPlan,
+    TrackWeightsWarning,
+    plan_track,
+    weight_scale_message,
+)
 
 
 def route_pairs(model: PlanningModel) -> list[tuple[str, str]]:
@@ -160,7 +166,7 @@ def plan_network(model: PlanningModel, progress=None, stage: str = "optimal") ->
             sub = confined[k] if layered else model
             p, q = ports[origin], ports[destination]
             try:
-                plan = plan_track(sub, (p.x, p.y, z), (q.x, q.y, z))
+                plan = plan_track(sub, (p.x, p.y, z), (q.x, q.y, z), scale_check=False)
             except NoTrackError as exc:
                 raise NoTrackError(f"route {origin}-{destination}: {exc.what}", exc.where, exc.fix) from None
             s = plan.stages[stage]
@@ -169,6 +175,11 @@ def plan_network(model: PlanningModel, progress=None, stage: str = "optimal") ->
                                       s.transport_cost, s.buffer_cost, k, plan)
             if progress is not None:
                 progress.update(1)
+    # one warning for the network, on its first route, when Eq. 10's two terms are scales apart
+    first = next(iter(routes.values()), None)
+    message = weight_scale_message(model, first.plan.stages["shortest"]) if first is not None else None
+    if message:
+        warnings.warn(f"route {first.name}: {message}", TrackWeightsWarning, stacklevel=2)
     return RouteNetwork(routes, tuple(model.field.grid.cell), model.scenario.name, stage,  # type: ignore[arg-type]
                         model.scenario.tracks.layering)
 
