@@ -22,7 +22,7 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 TINY = ROOT / "tests" / "data" / "sweeps" / "tiny.toml"
 PAPER = ROOT / "models" / "paper_case.toml"
-COLUMNS = ["case", "schedule.aircraft", "aircraft.cruise_speed_mps", "solver", "seed", "status", "model", "objective", "bound",
+COLUMNS = ["case", "schedule.aircraft", "aircraft.cruise_speed_mps", "solver", "seed", "status", "model", "objective_kind", "objective", "bound",
            "gap", "operated", "cancelled", "total_delay_s", "avg_delay_s", "verified", "seconds", "risk_cost",
            "transport_cost", "length_m", "n_waypoints"]
 

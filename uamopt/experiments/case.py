@@ -63,7 +63,8 @@ def schedule_row(problem, schedule, seconds: float) -> dict:
     gap = math.nan
     if solved and math.isfinite(bound) and abs(objective) > 1e-9:
         gap = abs(objective - bound) / abs(objective)
-    return {"status": schedule.status, "model": schedule.extras.get("model_kind"), "objective": objective, "bound": bound, "gap": gap,
+    return {"status": schedule.status, "model": schedule.extras.get("model_kind"),
+            "objective_kind": problem.objective_kind, "objective": objective, "bound": bound, "gap": gap,
             "operated": schedule.operated_count, "cancelled": schedule.cancelled,
             "total_delay_s": schedule.total_delay_s, "avg_delay_s": schedule.avg_delay_s,
             "verified": verify(problem, schedule).ok, "seconds": seconds}

@@ -197,8 +197,9 @@ def sweep_lines(table, x: str | None = None, hue: str | None = None, y: str | No
         a.set_xlabel(_label(x))
         a.set_ylabel(_label(y))
         key = key if isinstance(key, tuple) else (key,)
+        note = objective_note(rows) if y in ("avg_delay_s", "total_delay_s", "fulfilment", "objective") else ""
         a.set_title(", ".join(f"{k} = {_short(v)}" for k, v in zip(facets, key)) + (" — " if facets else "")
-                    + "median over seeds, band: min–max", fontsize=9)
+                    + "median over seeds, band: min–max" + (f"\n{note}" if note else ""), fontsize=9)
         if hue is not None:
             a.legend(title=_label(hue), fontsize=8, title_fontsize=8)
         _bounded(a, y)
@@ -231,10 +232,21 @@ def _by_solver(table, key: str, y, ax, ylabel: str, xlabel: str) -> None:
     ax.legend(title="solver")
 
 
+def objective_note(table) -> str:
+    """The objective(s) a schedule table was solved under, as a figure names them."""
+    if "objective_kind" not in table:
+        return ""
+    kinds = [str(k) for k in dict.fromkeys(table["objective_kind"].dropna())]
+    words = {"lexicographic": "lexicographic objective (most flights, then least delay)",
+             "weighted": "Eq. 20 weighted objective"}
+    return ", ".join(words.get(k, k) for k in kinds)
+
+
 def _delays(table, key: str, ax, label: str):
     fig, axes = _axes(ax, 2)
     _by_solver(table, key, lambda r: _float(r["avg_delay_s"]), axes[0], "average delay T_d (s, Eq. 21)", label)
-    axes[0].set_title("Average delay (median over seeds, band: range)")
+    note = objective_note(table)
+    axes[0].set_title("Average delay (median over seeds, band: range)" + (f"\n{note}" if note else ""), fontsize=10)
     _bounded(axes[0], "avg_delay_s")
     if len(axes) > 1:
         _by_solver(table, key, DERIVED["fulfilment"][1], axes[1], "planned flights operated (%)", label)

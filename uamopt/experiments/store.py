@@ -29,7 +29,7 @@ RESULTS = "results.parquet"
 
 #: column -> pandas dtype, in table order (the swept keys follow ``case``)
 HEAD = {"case": "str"}
-SCHEDULE = {"solver": "str", "seed": "Int64", "status": "str", "model": "str", "objective": "float64", "bound": "float64",
+SCHEDULE = {"solver": "str", "seed": "Int64", "status": "str", "model": "str", "objective_kind": "str", "objective": "float64", "bound": "float64",
             "gap": "float64", "operated": "Int64", "cancelled": "Int64", "total_delay_s": "float64",
             "avg_delay_s": "float64", "verified": "boolean", "seconds": "float64"}
 PLAN = {"risk_cost": "float64", "transport_cost": "float64", "length_m": "float64", "n_waypoints": "Int64"}
