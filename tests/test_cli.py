@@ -197,3 +197,16 @@ def test_out_is_a_file(tmp_path, capsys):
     target.write_text("keep me")
     assert_one_line_error(*cli(capsys, "risk", PAPER, "--out", str(target))[::2], "output path is a file")
     assert target.read_text() == "keep me"
+
+
+def test_a_degenerate_weighting_is_one_warning_line(tmp_path):
+    """tracks.risk_model = "continuous" makes ω4·C_R about 10⁻³ of ω5·C_T at the default weights:
+    the command says so in one `warning:` line naming the keys, and still writes its result."""
+    out = tmp_path / "plan"
+    done = run("plan", PAPER, "--set", 'tracks.risk_model="continuous"', "--no-figures", "--out", str(out))
+    assert done.returncode == 0, done.stderr
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("warning: ") and "tracks.weights" in lines[0], done.stderr
+    assert (out / "tracks.json").is_file()
+    quiet = run("plan", PAPER, "--no-figures", "--out", str(tmp_path / "default"))
+    assert quiet.returncode == 0 and "warning" not in quiet.stderr, quiet.stderr  # the binary default: no warning

@@ -10,6 +10,7 @@ from __future__ import annotations
 import argparse
 import sys
 import time
+import warnings
 from pathlib import Path
 
 from uamopt.errors import UamoptError
@@ -196,10 +197,24 @@ def _interrupted(args, interrupt: KeyboardInterrupt) -> int:
     return handled(interrupt)
 
 
+def _warning_line(message, category, filename, lineno, file=None, line=None) -> None:
+    """uamopt's own warnings (e.g. TrackWeightsWarning) as one ``warning: ...`` line on stderr;
+    every other library's warning as Python prints it."""
+    if getattr(category, "__module__", "").startswith("uamopt"):
+        text = " ".join(str(message).split())  # one line whatever the message holds
+        (file or sys.stderr).write(f"warning: {text}\n")
+    else:
+        _PYTHON_SHOWWARNING(message, category, filename, lineno, file, line)
+
+
+_PYTHON_SHOWWARNING = warnings.showwarning
+
+
 def main(argv: list[str] | None = None) -> int:
     from uamopt.interrupts import install_handlers, interrupt_of
 
     install_handlers()  # SIGTERM cleans up like Ctrl-C (uamopt.interrupts)
+    warnings.showwarning = _warning_line
     try:
         args = build_parser().parse_args(argv)
     except KeyboardInterrupt as exc:
