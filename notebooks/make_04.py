@@ -94,12 +94,12 @@ frame["paper (Nanjing): C_R vs shortest"] = ["", "-11.36%", "-11.36%", "-7.69%"]
 frame["paper (Nanjing): C_T vs shortest"] = ["", "+20.56%", "+18.16%", "+13.59%"]
 frame"""),
     code("""ua.plotting.tracks(plan, model, title="Kamppi -> Senaatintori")"""),
-    md("""**Where ours differ, and why.** The initial track avoids risk as the paper's does. Here the
-equivalent and optimal tracks give much of that back: the exact equivalent track is the *shortest*
-polyline through the initial track's corridor of cells (docs/readings.md, *The four stages*), and in
-these narrow streets the shortest line runs longer over road cells than the grid path did. The
-variant `tracks.equivalent = "exact_cost"` minimises Eq. 10 in the corridor instead and keeps more
-of the gain (shown for comparison):"""),
+    md("""**Where ours differ, and why.** The initial track avoids risk as the paper's does, and the
+later stages keep it: the exact equivalent track is the *shortest* polyline through the initial
+track's corridor of cells under the bound C_R ≤ (1 + `tracks.risk_tolerance`) × the initial track's
+(docs/readings.md, *The four stages*); in these narrow streets the unbounded shortest line would run
+longer over road cells than the grid path did. The variant `tracks.equivalent = "exact_cost"`
+minimises Eq. 10 in the corridor instead (shown for comparison):"""),
     code("""variant = ua.load_scenario(root / "models" / "helsinki.toml", (SMALL_SET if SMALL else []) + ["tracks.equivalent=exact_cost"])
 by_cost = ua.plan_track(ua.planning_model(variant, field), "Kamppi", "Senaatintori")
 # the same corridor (the same initial track); the shortest polyline is a feasible point of the Eq. 10 program
