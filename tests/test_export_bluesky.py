@@ -72,9 +72,10 @@ def _plan_at(waypoints, speed, departure, t):
 
 def test_scenario_flies_each_operated_flight_on_a_flyable_trajectory_near_its_plan(scn):
     """Each aircraft is created at the first clock step after its departure, on its plan, and is
-    commanded a polyline whose position at every instant is within 8.2 m of the plan's (the
-    designed trajectory, ≤ 7.81 m on the paper case's tracks, plus ≤ 0.3 m of the first-order
-    georeference), whose velocity changes by at most g·tan 45° per second, and which reaches the
+    commanded a polyline whose position at every instant is within 8.5 m of the plan's (the
+    designed trajectory, ≤ 8.20 m on the paper case's tracks — a regression value of this version's
+    tracks, 7.81 m before the corridor points kept inside their cells — plus ≤ 0.3 m of the
+    first-order georeference; the replay's budget e_h = 10 m is the requirement behind it), whose velocity changes by at most g·tan 45° per second, and which reaches the
     destination at the planned arrival."""
     readscn = pytest.importorskip("bluesky.stack.simstack").readscn
     lines = readscn(str(scn / "bluesky.scn"))
@@ -94,7 +95,7 @@ def test_scenario_flies_each_operated_flight_on_a_flyable_trajectory_near_its_pl
         t = np.linspace(times[0], times[-1], 20001)
         flown = np.column_stack([np.interp(t, times, points[:, k]) for k in range(3)])
         error = flown - _plan_at(wp, 25.0, departure, t)
-        assert np.hypot(error[:, 0], error[:, 1]).max() < 8.2 and np.abs(error[:, 2]).max() < 0.01
+        assert np.hypot(error[:, 0], error[:, 1]).max() < 8.5 and np.abs(error[:, 2]).max() < 0.01
         velocity = np.diff(points, axis=0) / np.diff(times)[:, None]
         dt = np.diff(times)
         assert (np.linalg.norm(np.diff(velocity, axis=0), axis=1) / (0.5 * (dt[:-1] + dt[1:]))).max(initial=0.0) < 9.81

@@ -48,7 +48,7 @@ from uamopt.schedule.model import Schedule, SchedulingProblem, make_schedule
 
 ROUND_S = 1e-9  # float round-off accepted when rounding a real time to units, s
 INT_LIMIT = 2**62  # keep |objective| below this (CP-SAT uses int64)
-CERTIFIED_GAP = 1e-6  # objective − continuous bound, relative, at which a lattice optimum is called optimal
+CERTIFIED_GAP = 1e-9  # objective − continuous bound, relative, at which a lattice optimum is called optimal (round-off only)
 
 
 def integer_objective(problem: SchedulingProblem, unit_s: float, delay_max: np.ndarray) -> tuple[int, int, float, str]:
