@@ -177,7 +177,9 @@ def test_track_waypoints_flown_at_constant_speed_leave_the_budget(paper_schedule
     result = replay(folder, window_s=(0.0, 600.0), trajectory="waypoints", write=False)
     errors = [f["max_horizontal_error_m"] for f in result.flights]
     assert result.los_count == 0 and max(errors) > 20.0 and len(result.over_budget) > len(errors) / 2
-    assert max(f["arrival_deviation_s"] for f in result.flights) < -0.05  # every flight early
+    # and off the plan's clock: early where a fly-by turn cuts a corner, late where it overshoots a
+    # tight zig-zag (V3-V4 on this version's tracks: +0.16 s, a regression value); never on time
+    assert min(abs(f["arrival_deviation_s"]) for f in result.flights) > 0.05
     print(f"waypoints: max horizontal error {max(errors):.1f} m, {len(result.over_budget)} of {len(errors)} over budget")
 
 
