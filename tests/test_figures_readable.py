@@ -371,3 +371,19 @@ def test_sweep_delay_figures_name_the_objective():
         assert "lexicographic objective" in fig.axes[0].get_title()
     weighted = table.assign(objective_kind="weighted")
     assert "Eq. 20 weighted" in plot_sweep(weighted, "flights").axes[0].get_title()
+
+
+def test_weights_study_spreads_a_far_point_on_a_log_axis():
+    """The weights sweep (Fig. 21 from models/variants/weights.toml): ¥29-31 and one ¥124 point."""
+    import pandas as pd
+
+    from uamopt.experiments.figures import plot_sweep
+
+    weights = ["[0.0, 1.0]", "[0.25, 0.75]", "[0.5, 0.5]", "[1.0, 0.0]"]
+    table = pd.DataFrame({"case": list("abcd"), "tracks.weights": weights, "status": "ok",
+                          "risk_cost": [300.0, 260.0, 250.0, 240.0], "transport_cost": [29.0, 30.0, 31.0, 124.0]})
+    ax = plot_sweep(table, "weights").axes[0]
+    assert ax.get_xscale() == "log" and "log scale" in ax.get_xlabel()
+    assert ax.get_title().lower().count("trade-off") <= 1
+    near = table.assign(transport_cost=[29.0, 30.0, 31.0, 32.0])
+    assert plot_sweep(near, "weights").axes[0].get_xscale() == "linear"  # spread points: a plain axis

@@ -304,9 +304,12 @@ def _weights(table, key: str, ax):
     axes[0].plot(cost, risk, "-o", color="tab:blue")
     for i, j in enumerate(order):
         axes[0].annotate(f"ω4={weights[j][0]:g}", (cost[i], risk[i]), textcoords="offset points", xytext=(5, 4), fontsize=8)
-    axes[0].set_xlabel("transport cost C_T (¥, Eq. 12)")
+    spread = np.nanmax(cost) / max(np.nanmin(cost), 1e-12) if len(cost) else 1.0
+    if spread > 2.0:  # one far point (ω4 = 1 at several times the others' cost) would squeeze the rest
+        axes[0].set_xscale("log")
+    axes[0].set_xlabel("transport cost C_T (¥, Eq. 12)" + (", log scale" if spread > 2.0 else ""))
     axes[0].set_ylabel("operational risk C_R (Eq. 11)")
-    axes[0].set_title("Trade-off between risk and transport cost (ω4, ω5)")
+    axes[0].set_title("Risk against transport cost over the weights (ω4, ω5)")
     axes[0].grid(alpha=0.3)
     return fig
 
