@@ -168,8 +168,8 @@ trends = pd.DataFrame({
 trends"""),
     md("""**Where ours differ, and why.** The column *holds here* says, for this run, whether each of
 the paper's trends appears. Before optimisation the preliminary strategy's delay need not fall
-monotonically with speed: at full size it is 164 → 77 → 116 → 98 → 63 s over 15…35 m/s (median of
-three seeds), because a faster aircraft also changes *which* flights meet in which cells, and the
+monotonically with speed (at full size, in this version, 164 → 77 → 87 → 92 → 62.5 s over
+15…35 m/s, median of three seeds: the table's last row), because a faster aircraft also changes *which* flights meet in which cells, and the
 conflict pattern of one speed is not a scaled copy of another's; the overall fall is the paper's
 trend, the steps between are ours. Under the default lexicographic objective the optimum operates
 every flight it can and delays the rest as little as possible, which is the paper's picture of
