@@ -189,7 +189,8 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
 
     from ortools.sat.python import cp_model
 
-    from uamopt.solvers.warmstart import no_worse, reduced, warm_start
+    from uamopt.solvers.milp import infeasible_reason
+    from uamopt.solvers.warmstart import no_schedule, no_worse, reduced, warm_start
 
     unit_s, want_bound = profile.option("time_unit_s"), profile.option("continuous_bound")
     options = {k: v for k, v in profile.options.items() if k not in ("time_unit_s", "continuous_bound")}  # CP-SAT's own
@@ -197,7 +198,7 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
     small = reduced(problem)  # dominance caps (warmstart.py): the same optima
     model, operate, delay, _, per_flight, divisor, how = build_cpsat(small, unit_s)
     start = warm_start(problem, seed=profile.seed, on_grid=True)
-    for f in range(problem.n_flights):
+    for f in range(problem.n_flights if start.found else 0):
         model.add_hint(operate[f], bool(start.operated[f]))
         model.add_hint(delay[f], int(np.rint(start.delay_s[f] / unit_s)) if start.operated[f] else 0)
     build_s = time.perf_counter() - t0  # model, warm start and hints
@@ -215,8 +216,11 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
         raise UamoptError(f"CP-SAT rejected the run: {why}", f"profile {profile.name or 'cpsat'}",
                           "check the profile's [options]" if not model.validate() else "report this as a bug")
     if code == cp_model.INFEASIBLE:
+        extras["reason"] = infeasible_reason(problem)
         return make_schedule(problem, "cpsat", "infeasible", np.zeros(n, bool), np.zeros(n), solve_seconds=seconds,
                              seed=profile.seed, extras=extras)
+    if code == cp_model.UNKNOWN and not start.found:
+        raise no_schedule(problem, profile.name or "cpsat", "CP-SAT stopped at its limit with no incumbent")
     if code == cp_model.UNKNOWN:  # no incumbent before the limit: the warm start
         return no_worse(problem, make_schedule(problem, "cpsat", "time_limit", np.zeros(n, bool), np.zeros(n),
                                                solve_seconds=seconds, seed=profile.seed, extras=extras), start)

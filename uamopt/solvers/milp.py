@@ -210,7 +210,7 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
     never returns a worse one (:func:`~uamopt.solvers.warmstart.no_worse`). The model is built on
     :func:`~uamopt.solvers.warmstart.reduced` (dominated delays cut off; the optima are unchanged).
     """
-    from uamopt.solvers.warmstart import no_worse, reduced, warm_start
+    from uamopt.solvers.warmstart import no_schedule, no_worse, reduced, warm_start
 
     t0 = time.perf_counter()
     options = dict(profile.options)
@@ -226,7 +226,8 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
     m = build_model(reduced(problem))  # delay bounds capped by dominance: the same optima (warmstart.py)
     build_s = time.perf_counter() - t0
     solver.set_instance(m)  # the persistent interface: load the model, then hand HiGHS the MIP start
-    _set_mip_start(solver, mip_start(m, problem, start.operated, start.delay_s))
+    if start.found:
+        _set_mip_start(solver, mip_start(m, problem, start.operated, start.delay_s))
     stopped: list = []
     if getattr(solver, "_solver_model", None) is not None:  # pyomo 6.10's persistent HiGHS object
         stopped = interrupt_at(solver._solver_model, t0 + profile.time_limit_s)  # where HiGHS listens (deadline.py)
@@ -250,6 +251,7 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
     bound = result.objective_bound if result.objective_bound is not None and np.isfinite(result.objective_bound) else None
     n = problem.n_flights
     if tc in (TerminationCondition.provenInfeasible, TerminationCondition.infeasibleOrUnbounded):
+        extras["reason"] = infeasible_reason(problem)
         return make_schedule(problem, "highs", "infeasible", np.zeros(n, bool), np.zeros(n), solve_seconds=time.perf_counter() - t0,
                              seed=profile.seed, extras=extras)
     if tc == TerminationCondition.convergenceCriteriaSatisfied and has_solution:
@@ -267,6 +269,8 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
         extras["polished"] = polished is not None
         raw = np.clip([pyo.value(m.delay[f]) for f in range(n)], 0.0, problem.delay_upper_s)
         delay = polished if polished is not None else np.where(operated, raw, 0.0)
+    elif not start.found:
+        raise no_schedule(problem, profile.name or "highs", f"HiGHS stopped ({tc.name}) with no incumbent")
     else:
         extras["incumbent"] = "none found: every flight cancelled"
     extras["warm_start"] = f"{start.source} {start.objective:.6f}"
@@ -289,8 +293,20 @@ def estimated_build_s(problem: SchedulingProblem) -> float:
     return rows * BUILD_S_PER_ROW
 
 
+def infeasible_reason(problem: SchedulingProblem) -> str:
+    """Why a proved-infeasible problem is infeasible, in words (the must-operate flights pinned)."""
+    pinned = [problem.flights.flights[f].id for f in np.flatnonzero(problem.must_operate)]
+    shown = ", ".join(pinned[:8]) + (", …" if len(pinned) > 8 else "")
+    return (f"no schedule operates every must-operate flight ({shown}) within the pair conflicts, turnarounds, "
+            "delay bounds and service window" if pinned else "the model has no feasible point")
+
+
 def _start_only(problem: SchedulingProblem, profile, start, t0: float, why: str) -> Schedule:
     """The warm start as the answer when the limit leaves HiGHS no time (status ``time_limit``, no bound)."""
+    if not start.found:
+        from uamopt.solvers.warmstart import no_schedule
+
+        raise no_schedule(problem, profile.name or "highs", why)
     return make_schedule(problem, "highs", "time_limit", start.operated, start.delay_s, solve_seconds=time.perf_counter() - t0,
                          seed=profile.seed, extras={"termination": "not run", "incumbent": why, "model": MODEL,
                                                     "warm_start": f"{start.source} {start.objective:.6f}"})

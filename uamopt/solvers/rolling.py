@@ -297,6 +297,8 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
         operated, delay = greedy_decisions(problem, o["step_s"] and float(o["step_s"]))
     bound = pair_matching_bound(problem)
     status = "time_limit" if stats["unproved"] else "feasible"
+    if not first.found and violations(problem, operated, delay):  # as greedy: a must-operate flight not placed
+        status, bound = "infeasible", None
     stats["bound_of"] = "pair-matching relaxation (rolling.py docstring)"
     return no_worse(problem, make_schedule(problem, "rolling", status, operated, delay, bound=bound,
                                            solve_seconds=time.perf_counter() - start, seed=profile.seed, extras=stats), first)

@@ -70,7 +70,7 @@ from uamopt.interrupts import stopping
 from uamopt.schedule.flights import TIME_TOL_S
 from uamopt.schedule.model import Schedule, SchedulingProblem, make_schedule
 from uamopt.solvers.deadline import highs_can_start, interrupt_at, quiet_highs
-from uamopt.solvers.warmstart import Start, no_worse, reduced, warm_start
+from uamopt.solvers.warmstart import Start, no_schedule, no_worse, reduced, warm_start
 
 ETA_S = 1e-9  # float round-off accepted when rounding a time to grid steps, s
 AUTO_HIGHS_COLUMNS = 8000  # engine "auto": HiGHS up to this many columns, "hybrid" above
@@ -383,7 +383,7 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
         engine = "highs" if int(np.sum(np.floor(small.delay_upper_s / step) + 1)) <= AUTO_HIGHS_COLUMNS else "hybrid"
     model = build_grid_model(small, step, kind, both_ways=engine == "cpsat")
     built = time.perf_counter() - t0
-    hint = model.columns_of(start.operated, start.delay_s) if kind == "grid" else None
+    hint = model.columns_of(start.operated, start.delay_s) if kind == "grid" and start.found else None
     limit = max(0.1, profile.time_limit_s - built - cont_s)
     result = run_engine(engine, model, problem, limit, profile.threads, profile.seed, gap, hint)
     extras = {"model": model_name(kind, step), "engine": engine, "termination": result.termination,
@@ -392,6 +392,23 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
               "engine_first_incumbent_s": result.first_incumbent_s, "engine_best_incumbent_s": result.best_incumbent_s,
               "engine_seconds": round(result.seconds, 3)}
     n = problem.n_flights
+    if result.x is None and "infeasible" in result.termination.lower():
+        # infeasible on the grid, a restriction: the continuous MILP (milp.py) decides, in the time left
+        import dataclasses
+
+        from uamopt.solvers import milp
+
+        left = max(0.1, profile.time_limit_s - (time.perf_counter() - t0))
+        proof = milp.solve(problem, dataclasses.replace(profile, solver="highs", time_limit_s=left, options={}))
+        if proof.status == "infeasible":
+            extras.update(reason=proof.extras.get("reason"), infeasible_proof="the continuous MILP (highs)")
+            return make_schedule(problem, "timeindexed", "infeasible", np.zeros(n, bool), np.zeros(n),
+                                 solve_seconds=time.perf_counter() - t0, seed=profile.seed, extras=extras)
+        extras.update(grid="infeasible on the grid; schedule from the continuous MILP", model_kind="continuous")
+        return make_schedule(problem, "timeindexed", proof.status, proof.operated, proof.delay_s, bound=proof.bound,
+                             solve_seconds=time.perf_counter() - t0, seed=profile.seed, extras={**proof.extras, **extras})
+    if not start.found and (kind == "relaxed" or result.x is None):
+        raise no_schedule(problem, profile.name or "timeindexed", f"the engine stopped ({result.termination}) with none")
     if kind == "relaxed":  # a bound only: the incumbent shown is the warm start (feasible, continuous)
         extras["incumbent"] = f"warm start ({start.source}); the relaxation's points are not schedules"
         return make_schedule(problem, "timeindexed", "time_limit", start.operated, start.delay_s, bound=result.bound,

@@ -30,6 +30,7 @@ nor for a flight that must operate or that a must-operate flight requires: it ca
 from __future__ import annotations
 
 import dataclasses
+import math
 import time
 from dataclasses import dataclass
 
@@ -42,18 +43,34 @@ from uamopt.schedule.model import (
     make_schedule,
     violations,
 )
+from uamopt.errors import UamoptError
 from uamopt.solvers.greedy import DEFAULT_STEP_S, greedy_decisions
 
 
 @dataclass(frozen=True)
 class Start:
-    """A feasible schedule to start from: decisions, objective and where it came from."""
+    """A feasible schedule to start from: decisions, objective and where it came from. ``operated``
+    is None (objective inf) when no cheap schedule satisfies the must-operate flights: the exact
+    model then decides whether any schedule does (``found`` is False)."""
 
-    operated: np.ndarray
-    delay_s: np.ndarray
+    operated: np.ndarray | None
+    delay_s: np.ndarray | None
     objective: float
     source: str
     seconds: float
+
+    @property
+    def found(self) -> bool:
+        return self.operated is not None
+
+
+def no_schedule(problem: SchedulingProblem, solver: str, why: str) -> UamoptError:
+    """The error for a solver that stopped with no schedule satisfying the must-operate flights
+    and without proving that none exists (a limit hit before either)."""
+    pinned = [problem.flights.flights[f].id for f in np.flatnonzero(problem.must_operate)[:5]]
+    return UamoptError(f"no schedule that operates every must-operate flight ({', '.join(pinned)}"
+                       f"{', …' if int(problem.must_operate.sum()) > 5 else ''}) was found: {why}",
+                       f"solver {solver}", "raise the time limit, or pin fewer flights")
 
 
 def reduced(problem: SchedulingProblem) -> SchedulingProblem:
@@ -105,7 +122,10 @@ def warm_start(problem: SchedulingProblem, step_s: float = DEFAULT_STEP_S, *, so
         value = evaluate(problem, operated, delay)
         if best is None or value < best[0] - 1e-12:
             best = (value, source, operated, delay)
-    assert best is not None  # the all-cancelled schedule is always feasible, and greedy never worse than it
+    if best is None:  # only with must-operate flights: no cheap schedule places them all
+        return Start(operated=None, delay_s=None, objective=math.inf,
+                     source="none (no cheap schedule operates every must-operate flight)",
+                     seconds=time.perf_counter() - t0)
     return Start(operated=best[2].copy(), delay_s=np.where(best[2], best[3], 0.0), objective=best[0], source=best[1],
                  seconds=time.perf_counter() - t0)
 
@@ -116,6 +136,8 @@ def no_worse(problem: SchedulingProblem, schedule: Schedule, start: Start) -> Sc
     A solver that proved optimality cannot be worse than a feasible start (up to its tolerances), so
     the swap only happens under a limit; the status becomes ``time_limit``.
     """
+    if not start.found:  # nothing to fall back on: the solver's own answer (callers refuse a non-schedule)
+        return schedule
     if schedule.objective is not None and schedule.objective <= start.objective + 1e-9 * (1.0 + abs(start.objective)):
         return schedule
     extras = dict(schedule.extras, incumbent=f"warm start ({start.source}): the solver's own was "

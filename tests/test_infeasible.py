@@ -1,0 +1,67 @@
+"""Infeasible is a status, never a crash: pinned (must-operate) flights that cannot all fly.
+
+Before, ``highs``, ``cpsat`` and ``timeindexed`` ended in a bare AssertionError in the warm start
+("the all-cancelled schedule is always feasible"), and HiGHS's infeasible branch used an undefined
+name. Each instance here is infeasible by hand (the reason in its docstring); the brute force, which
+shares no code with the solvers' models, agrees."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+from instances import CROSS_A, CROSS_C
+
+import uamopt as ua
+from uamopt.schedule import Flight, FlightSet, build_problem
+from uamopt.solvers import bruteforce
+
+EXACT = ["highs", "cpsat", "timeindexed", "exact"]
+HEURISTICS = ["greedy", "ga", "soa", "rolling"]
+
+
+def flight(fid, aircraft, track, dep, max_delay=0.0):
+    return Flight(id=fid, aircraft=aircraft, route=fid, origin="a", destination="b", speed_mps=25.0,
+                  planned_departure_s=dep, max_delay_s=max_delay, waypoints=track)
+
+
+def pinned(flights, kind):
+    problem = build_problem(FlightSet(cell=(50.0, 50.0, 30.0), conflict_radius=1, flights=flights),
+                            weights=(0.6, 0.4), objective=kind)
+    return dataclasses.replace(problem, must_operate=np.ones(len(flights), dtype=bool))
+
+
+def crossing(kind):
+    """A1 (east, t = 0) and C1 (north across it, t = 0) share the conflict zone whenever
+    dep_C − dep_A ∈ (−4, 8) s (tests/instances.py); neither may wait, both must fly."""
+    return pinned((flight("A1", "A", CROSS_A, 0.0), flight("C1", "C", CROSS_C, 0.0)), kind)
+
+
+def turnaround(kind):
+    """One aircraft: A1 flies 20 s from t = 0, its next flight A2 is planned at t = 5 s and may not
+    wait: the aircraft would be in two places at once (Eqs. 27-28); both must fly."""
+    back = CROSS_A[::-1].copy()
+    return pinned((flight("A1", "A", CROSS_A, 0.0), flight("A2", "A", back, 5.0)), kind)
+
+
+@pytest.mark.parametrize("make", [crossing, turnaround], ids=["conflict", "turnaround"])
+@pytest.mark.parametrize("kind", ["weighted", "lexicographic"])
+def test_every_solver_says_infeasible(make, kind):
+    problem = make(kind)
+    assert bruteforce.solve(problem).status == "infeasible"  # the oracle: no schedule exists
+    for name in EXACT + HEURISTICS:
+        schedule = ua.solve(problem, name, time_limit_s=20)
+        assert schedule.status == "infeasible", (name, schedule.status)
+        assert schedule.objective is None
+        if name in EXACT:  # a proof, with the pinned flights named
+            assert "A1" in schedule.extras["reason"] and schedule.extras["reason"].startswith("no schedule operates")
+
+
+@pytest.mark.parametrize("name", EXACT)
+def test_a_feasible_pin_still_solves(name):
+    """Pinning only A1 of the crossing is feasible (C1 is cancelled): no false "infeasible"."""
+    problem = dataclasses.replace(crossing("lexicographic"), must_operate=np.array([True, False]))
+    schedule = ua.solve(problem, name, time_limit_s=20)
+    assert schedule.status in ("optimal", "optimal_on_grid") and schedule.operated.tolist() == [True, False]
+    assert ua.verify(problem, schedule).ok
