@@ -96,3 +96,82 @@ def test_conflicting_folder_is_exit_1(good, tmp_path, capsys):
     (folder / "summary.json").unlink()
     assert main(["verify", str(folder)]) == 1
     assert "conflict: flights" in capsys.readouterr().out
+
+
+# --- crafted folders that used to pass (issue 22): each exited 0 ---------------------------------
+def _shifted(good, tmp_path, offset_s: float, name: str = "shifted"):
+    """A copy of ``good`` with every time (planned, departure, arrival, service window) moved by
+    ``offset_s``: the same schedule, honestly, at another magnitude of time."""
+    import csv
+
+    folder = tmp_path / name
+    shutil.copytree(good, folder)
+    doc = json.loads((folder / "flights.json").read_text())
+    doc["service_start_s"] = doc.get("service_start_s", 0.0) + offset_s
+    doc["service_end_s"] = doc.get("service_end_s", 3600.0) + offset_s
+    for f in doc["flights"]:
+        f["planned_departure_s"] += offset_s
+    (folder / "flights.json").write_text(json.dumps(doc))
+    with open(folder / "schedule.csv", newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    for r in rows:
+        for key in ("planned_departure_s", "departure_s", "arrival_s"):
+            if r[key] != "":
+                r[key] = repr(float(r[key]) + offset_s)
+    with open(folder / "schedule.csv", "w", newline="") as fh:
+        writer = csv.DictWriter(fh, fieldnames=list(rows[0]))
+        writer.writeheader()
+        writer.writerows(rows)
+    return folder, rows
+
+
+def _rewrite(folder, rows):
+    import csv
+
+    with open(folder / "schedule.csv", "w", newline="") as fh:
+        writer = csv.DictWriter(fh, fieldnames=list(rows[0]))
+        writer.writeheader()
+        writer.writerows(rows)
+
+
+def test_a_negative_turnaround_gap_is_refused(good, tmp_path, capsys):
+    """outbound_gap_s < 0 let an aircraft depart before its previous flight arrived."""
+    folder = tampered(good, tmp_path, _set("outbound_gap_s", -3000.0))
+    assert main(["verify", str(folder)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: ") and err.count("\n") == 1 and "must be ≥ 0" in err
+
+
+def test_departures_before_the_service_start_are_violations(good, tmp_path, capsys):
+    folder = tampered(good, tmp_path, _set("service_start_s", 300.0))  # flights planned from 0 s
+    assert main(["verify", str(folder)]) == 1
+    assert "before the service start" in capsys.readouterr().out
+
+
+def test_a_negative_planned_departure_is_a_violation(good, tmp_path, capsys):
+    folder, rows = _shifted(good, tmp_path, -50.0)  # every flight 50 s earlier, the window kept at 0 s
+    doc = json.loads((folder / "flights.json").read_text())
+    doc["service_start_s"], doc["service_end_s"] = 0.0, 3600.0
+    (folder / "flights.json").write_text(json.dumps(doc))
+    assert main(["verify", str(folder)]) == 1
+    out = capsys.readouterr().out
+    assert "s before the service start 0 s (Eq. 23)" in out and "planned departure -" in out
+
+
+@pytest.mark.parametrize("what", ["departure", "arrival"])
+def test_absolute_time_tolerance_at_any_magnitude(good, tmp_path, capsys, what):
+    """Near 9·10⁶ s a relative 1e-6 tolerance is 9 s: a departure 8 s early, or an arrival 8 s
+    off length / speed, passed."""
+    folder, rows = _shifted(good, tmp_path, 9e6)
+    assert main(["verify", str(folder)]) == 0, capsys.readouterr().out  # honestly shifted: still feasible
+    capsys.readouterr()
+    row = next(r for r in rows if r["operated"] == "1")
+    if what == "departure":  # 8 s early, the arrival kept consistent with it
+        row["departure_s"] = repr(float(row["departure_s"]) - 8.0)
+        row["arrival_s"] = repr(float(row["arrival_s"]) - 8.0)
+    else:
+        row["arrival_s"] = repr(float(row["arrival_s"]) + 8.0)
+    _rewrite(folder, rows)
+    assert main(["verify", str(folder)]) == 1
+    out = capsys.readouterr().out
+    assert f"flight {row['flight']}: {what}" in out

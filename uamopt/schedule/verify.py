@@ -7,11 +7,13 @@ analyser that walks each segment cell by cell in plain Python, Amanatides & Woo 
 the model's vectorised sort of all plane-crossing times) and its own conflict search (a hash of
 (block of cells, time bucket) instead of the model's forbidden departure gaps).
 
-Rules checked (tolerance ``TOL_S`` = 1e-6 s on every time):
+Rules checked (tolerance ``TOL_S`` = 1e-6 s on every time, absolute at any magnitude of time plus
+the float round-off of that magnitude, ``close_s``):
 
 - each flight of flights.json appears once in schedule.csv with the same aircraft, route and
   planned departure; departure = planned + delay; arrival = departure + length / speed (Eq. 31);
-- 0 ≤ delay ≤ max_delay_s (Eq. 29) and arrival ≤ service end (Eq. 26);
+- 0 ≤ delay ≤ max_delay_s (Eq. 29), service start ≤ planned departure and departure (Eq. 23),
+  arrival ≤ service end (Eq. 26); turnaround gaps are never negative;
 - a return (even leg of its aircraft) is not operated without its outbound;
 - an operated flight departs ≥ the previous operated flight's arrival + ΔT (Eqs. 27-28:
   T_D after an odd leg, T_R after an even leg);
@@ -41,7 +43,7 @@ from collections import defaultdict
 from pathlib import Path
 
 from uamopt.errors import InputFileError
-from uamopt.schedule.verify_summary import TOL_S, check_summary, close
+from uamopt.schedule.verify_summary import TOL_S, check_summary
 
 TIE_S = 1e-9  # crossings closer than this are simultaneous, s
 BUCKET_S = 30.0  # time bucket of the conflict hash, s
@@ -51,6 +53,15 @@ SPEED_RANGE_MPS = (0.1, 200.0)  # ground speeds a flight file may claim, m/s
 MAX_TIME_S = 1e7  # |planned departure| and delay bounds, s (about 116 days)
 MAX_COORD_M = 1e6  # waypoint coordinates of the local frame, m (1,000 km)
 MAX_VISITS = 10_000_000  # cell visits and time buckets the conflict search may hold (about 1 GB)
+ULP = 1e-14  # float round-off per unit of magnitude allowed on top of TOL_S (1e-7 s at 10⁷ s)
+
+
+def close_s(a: float, b: float) -> bool:
+    """Two times equal within ``TOL_S`` seconds *absolute* (plus the round-off of their magnitude):
+    a relative tolerance would let a departure at 9·10⁶ s be 9 s early."""
+    return math.isfinite(a) and math.isfinite(b) and abs(a - b) <= TOL_S + ULP * max(abs(a), abs(b))
+
+
 COLUMNS = ["flight", "aircraft", "route", "operated", "planned_departure_s", "delay_s", "departure_s", "arrival_s"]
 
 
@@ -139,10 +150,16 @@ def _read_flights(path: Path) -> dict:
                              "rewrite the file with uamopt schedule (the scenario's schedule.conflict_radius)")
     out = {
         "cell": cell, "radius": radius, "flights": [],
+        "service_start_s": _number(raw.get("service_start_s", 0.0), "service_start_s", str(path)),
         "service_end_s": _number(raw.get("service_end_s", 3600.0), "service_end_s", str(path)),
         "gaps": (_number(raw.get("outbound_gap_s", 240.0), "outbound_gap_s", str(path)),
                  _number(raw.get("return_gap_s", 360.0), "return_gap_s", str(path))),
     }
+    if min(out["gaps"]) < 0 or abs(out["service_start_s"]) > MAX_TIME_S:
+        raise InputFileError(f"outbound_gap_s and return_gap_s must be ≥ 0 (a negative turnaround puts one aircraft in "
+                             f"two places at once) and service_start_s within ±{MAX_TIME_S:g} s, got gaps "
+                             f"{list(out['gaps'])}, service_start_s {out['service_start_s']:g}", str(path),
+                             "rewrite the file with uamopt schedule")
     seen: set[str] = set()
     for f in flights:
         where = f"{path}: flight {f.get('id') if isinstance(f, dict) else '?'}"
@@ -306,7 +323,10 @@ def verify_files(flights_path: Path, schedule_path: Path, summary_path: Path | N
             out.append(f"flight {f['id']}: listed more than once in schedule.csv")
         if row["row"]["aircraft"] != f["aircraft"] or row["row"]["route"] != f["route"]:
             out.append(f"flight {f['id']}: aircraft/route in schedule.csv differ from flights.json")
-        if not close(row["planned"], f["planned"]):
+        if f["planned"] < spec["service_start_s"] - TOL_S:
+            out.append(f"flight {f['id']}: planned departure {f['planned']:g} s before the service start "
+                       f"{spec['service_start_s']:g} s (Eq. 23)")
+        if not close_s(row["planned"], f["planned"]):
             out.append(f"flight {f['id']}: planned departure {row['planned']} differs from flights.json's {f['planned']}")
         f["operated"] = row["operated"]
         if not row["operated"]:
@@ -315,9 +335,12 @@ def verify_files(flights_path: Path, schedule_path: Path, summary_path: Path | N
         f["departure"], f["arrival"] = row["departure"], row["arrival"]
         if d < -TOL_S or d > f["max_delay"] + TOL_S:
             out.append(f"flight {f['id']}: delay {d:g} s outside [0, {f['max_delay']:g}] s (Eq. 29)")
-        if not close(f["departure"], f["planned"] + d):
+        if f["departure"] < spec["service_start_s"] - TOL_S:
+            out.append(f"flight {f['id']}: departs at {f['departure']:.3f} s, before the service start "
+                       f"{spec['service_start_s']:g} s (Eq. 23)")
+        if not close_s(f["departure"], f["planned"] + d):
             out.append(f"flight {f['id']}: departure {f['departure']} s ≠ planned {f['planned']} + delay {d} s")
-        if not close(f["arrival"], f["departure"] + f["length"] / f["speed"]):
+        if not close_s(f["arrival"], f["departure"] + f["length"] / f["speed"]):
             out.append(f"flight {f['id']}: arrival {f['arrival']} s ≠ departure + track length / speed "
                        f"= {f['departure'] + f['length'] / f['speed']:.6f} s")
         if f["arrival"] > spec["service_end_s"] + TOL_S:
