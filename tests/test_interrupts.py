@@ -93,3 +93,19 @@ def test_an_interrupt_stops_a_long_solve_at_once(solver, sig, raised):
     name, seconds = done.stderr.split(" after ")
     # stopped by the interrupt (sent at 8 s), not by the 120 s limit: a margin no loaded machine closes
     assert name == raised and 8 <= int(seconds.split()[0]) < 90, done.stderr
+
+
+def test_a_signal_that_cuts_an_extension_import_is_still_an_interrupt(monkeypatch):
+    """SIGTERM during shapely's Cython initialisation surfaced as ImportError("PyCapsule_Import could
+    not import module 'shapely'") with no chain to the Terminated our handler raised: the CLI
+    printed a traceback (seen once in CI, test_output_safety's sigterm case). The handler now
+    records what it raised, and interrupt_of finds it behind such an ImportError only."""
+    from uamopt import interrupts
+
+    monkeypatch.setattr(interrupts, "_LAST", [])
+    cut = ImportError('PyCapsule_Import could not import module "shapely"')
+    assert interrupts.interrupt_of(cut) is None  # no signal came: a real import error stays one
+    with pytest.raises(interrupts.Terminated) as raised:
+        interrupts._raise_terminated(15, None)
+    assert interrupts.interrupt_of(cut) is raised.value
+    assert interrupts.interrupt_of(ValueError("unrelated")) is None  # only an import can be cut so

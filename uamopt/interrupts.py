@@ -32,8 +32,19 @@ class Terminated(KeyboardInterrupt):
     """SIGTERM, raised like Ctrl-C so that clean-up code runs."""
 
 
+#: the last interrupt raised by a handler of ours: an extension module's import that a signal cut
+#: (shapely's Cython init) reports a plain ImportError with no chain back to it (interrupt_of)
+_LAST: list[KeyboardInterrupt] = []
+
+
 def _raise_terminated(signum, frame) -> None:
-    raise Terminated()
+    _LAST[:] = [Terminated()]
+    raise _LAST[0]
+
+
+def _raise_interrupt(signum, frame) -> None:
+    _LAST[:] = [KeyboardInterrupt()]
+    raise _LAST[0]
 
 
 def _unraisable_hook(default):
@@ -59,19 +70,26 @@ def install_handlers() -> None:
     back instead of printing a traceback (the CLI calls this once, in the main thread)."""
     if threading.current_thread() is threading.main_thread():
         signal.signal(signal.SIGTERM, _raise_terminated)
+        if signal.getsignal(signal.SIGINT) is signal.default_int_handler:  # the same, recorded
+            signal.signal(signal.SIGINT, _raise_interrupt)
         if not getattr(sys.unraisablehook, "uamopt", False):
             sys.unraisablehook = _unraisable_hook(sys.unraisablehook)
 
 
 def interrupt_of(exc: BaseException) -> KeyboardInterrupt | None:
     """The interrupt behind ``exc``: itself, or one in its cause/context chain (a library may
-    wrap a KeyboardInterrupt raised inside its callback in an error of its own)."""
+    wrap a KeyboardInterrupt raised inside its callback in an error of its own), or, for an
+    ImportError, the interrupt our handler raised last (a signal that cut an extension module's
+    initialisation surfaces as that module's ImportError, with no chain)."""
     seen = set()
+    first = exc
     while exc is not None and id(exc) not in seen:
         if isinstance(exc, KeyboardInterrupt):
             return exc
         seen.add(id(exc))
         exc = exc.__cause__ or exc.__context__
+    if isinstance(first, ImportError) and _LAST:
+        return _LAST[0]
     return None
 
 
