@@ -118,10 +118,7 @@ def _shifted(good, tmp_path, offset_s: float, name: str = "shifted"):
         for key in ("planned_departure_s", "departure_s", "arrival_s"):
             if r[key] != "":
                 r[key] = repr(float(r[key]) + offset_s)
-    with open(folder / "schedule.csv", "w", newline="") as fh:
-        writer = csv.DictWriter(fh, fieldnames=list(rows[0]))
-        writer.writeheader()
-        writer.writerows(rows)
+    _rewrite(folder, rows)
     return folder, rows
 
 

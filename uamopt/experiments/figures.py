@@ -39,7 +39,7 @@ DERIVED = {"fulfilment": ("planned flights operated (%)", lambda t: 100.0 * _flo
 #: axis labels of the result columns (docs/sweeps.md) and of the keys the paper's studies sweep
 LABELS = {
     "avg_delay_s": "average delay T_d (s, Eq. 21)", "total_delay_s": "total delay Σd (s)",
-    "operated": "flights operated S (Eq. 22)", "cancelled": "flights cancelled", "objective": "objective (Eq. 20)",
+    "operated": "flights operated S (Eq. 22)", "cancelled": "flights cancelled", "objective": "objective (schedule.objective: lexicographic or Eq. 20)",
     "bound": "bound of the objective", "gap": "gap |objective − bound| / |objective|",
     "seconds": "computing time of the stage (s)", "risk_cost": "operational risk C_R (Eq. 11)",
     "transport_cost": "transport cost C_T (¥, Eq. 12)", "length_m": "length (m)", "n_waypoints": "waypoints",

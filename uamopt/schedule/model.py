@@ -20,8 +20,10 @@ Constraints (docs/readings.md, Scheduling):
 5. Must operate: c_f = 1 where ``must_operate[f]`` (none in the paper's model).
 
 Objective (Eqs. 20-22): ``"weighted"``: W = ω6·Σ_f c_f d_f / G − ω7·Σ_f c_f (minimised);
-``"lexicographic"``: most operated flights first, then least total delay, as the scalar
-−S + Σ c d / (Σ delay_upper + 1) (the delay term lies in [0, 1), so S decides first).
+``"lexicographic"`` (the scenario default, docs/readings.md *Objective*: the paper's stated aim
+"minimize delays and maximize the number of flights", Sec. 4.3): most operated flights first, then
+least total delay, as the scalar −S + Σ c d / (Σ delay_upper + 1) (the delay term lies in [0, 1),
+so S decides first).
 
 The objective, the pair view of the conflicts and "must operate" are defined once, in
 :mod:`uamopt.schedule.core`, as ``problem.objective``, ``problem.pairs`` and ``problem.must_operate``.

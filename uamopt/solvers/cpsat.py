@@ -189,8 +189,7 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
 
     from ortools.sat.python import cp_model
 
-    from uamopt.solvers.milp import infeasible_reason
-    from uamopt.solvers.warmstart import no_schedule, no_worse, reduced, warm_start
+    from uamopt.solvers.warmstart import infeasible_reason, no_schedule, no_worse, reduced, warm_start
 
     unit_s, want_bound = profile.option("time_unit_s"), profile.option("continuous_bound")
     options = {k: v for k, v in profile.options.items() if k not in ("time_unit_s", "continuous_bound")}  # CP-SAT's own

@@ -210,7 +210,7 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
     never returns a worse one (:func:`~uamopt.solvers.warmstart.no_worse`). The model is built on
     :func:`~uamopt.solvers.warmstart.reduced` (dominated delays cut off; the optima are unchanged).
     """
-    from uamopt.solvers.warmstart import no_schedule, no_worse, reduced, warm_start
+    from uamopt.solvers.warmstart import infeasible_reason, no_schedule, no_worse, reduced, warm_start
 
     t0 = time.perf_counter()
     options = dict(profile.options)
@@ -291,14 +291,6 @@ def estimated_build_s(problem: SchedulingProblem) -> float:
     chains = sum(len(c) * (len(c) - 1) // 2 for c in problem.chains)
     rows = 2 * problem.n_flights + chains + 3 * int(ptr[-1]) + len(problem.pairs)
     return rows * BUILD_S_PER_ROW
-
-
-def infeasible_reason(problem: SchedulingProblem) -> str:
-    """Why a proved-infeasible problem is infeasible, in words (the must-operate flights pinned)."""
-    pinned = [problem.flights.flights[f].id for f in np.flatnonzero(problem.must_operate)]
-    shown = ", ".join(pinned[:8]) + (", …" if len(pinned) > 8 else "")
-    return (f"no schedule operates every must-operate flight ({shown}) within the pair conflicts, turnarounds, "
-            "delay bounds and service window" if pinned else "the model has no feasible point")
 
 
 def _start_only(problem: SchedulingProblem, profile, start, t0: float, why: str) -> Schedule:

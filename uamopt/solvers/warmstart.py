@@ -64,12 +64,24 @@ class Start:
         return self.operated is not None
 
 
+def _pinned(problem: SchedulingProblem, shown: int = 8) -> str:
+    """The must-operate flights' ids, the first ``shown`` of them."""
+    ids = [problem.flights.flights[f].id for f in np.flatnonzero(problem.must_operate)]
+    return ", ".join(ids[:shown]) + (", …" if len(ids) > shown else "")
+
+
+def infeasible_reason(problem: SchedulingProblem) -> str:
+    """Why a proved-infeasible problem is infeasible, in words (the must-operate flights pinned)."""
+    if not problem.must_operate.any():
+        return "the model has no feasible point"
+    return (f"no schedule operates every must-operate flight ({_pinned(problem)}) within the pair conflicts, "
+            "turnarounds, delay bounds and service window")
+
+
 def no_schedule(problem: SchedulingProblem, solver: str, why: str) -> UamoptError:
     """The error for a solver that stopped with no schedule satisfying the must-operate flights
     and without proving that none exists (a limit hit before either)."""
-    pinned = [problem.flights.flights[f].id for f in np.flatnonzero(problem.must_operate)[:5]]
-    return UamoptError(f"no schedule that operates every must-operate flight ({', '.join(pinned)}"
-                       f"{', …' if int(problem.must_operate.sum()) > 5 else ''}) was found: {why}",
+    return UamoptError(f"no schedule that operates every must-operate flight ({_pinned(problem, 5)}) was found: {why}",
                        f"solver {solver}", "raise the time limit, or pin fewer flights")
 
 
