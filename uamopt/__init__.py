@@ -49,6 +49,7 @@ _LAZY = {
     "RouteNetwork": "uamopt.planning.network", "weight_sweep": "uamopt.planning.pareto",
     "FlightSet": "uamopt.schedule.flights", "SchedulingProblem": "uamopt.schedule.model",
     "Schedule": "uamopt.schedule.model", "SolverProfile": "uamopt.solvers",
+    "read_airland": "uamopt.schedule.airland", "Objective": "uamopt.schedule.core",
     "load_risk": "uamopt.io", "load_tracks": "uamopt.io", "load_network": "uamopt.io",
     "load_flights": "uamopt.io", "load_schedule": "uamopt.io",
     # experiments: not modules of these names, so that importing one never shadows the function

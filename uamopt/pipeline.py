@@ -129,11 +129,12 @@ def solver_profile(profile: SolverProfile | str | Path, **overrides) -> SolverPr
     return dataclasses.replace(base, **overrides) if overrides else base
 
 
-def solve(problem: SchedulingProblem, profile: SolverProfile | str | Path = "greedy", **overrides) -> Schedule:
-    """Run one solver profile on the problem, e.g. ``solve(problem, "highs", time_limit_s=30)``."""
+def solve(problem: SchedulingProblem, profile: SolverProfile | str | Path = "greedy", *, extra=None, **overrides) -> Schedule:
+    """Run one solver profile on the problem, e.g. ``solve(problem, "highs", time_limit_s=30)``;
+    ``extra``: a callback that edits the exact model before it is solved (highs, cpsat; docs/variants.md)."""
     from uamopt.solvers import solve as run
 
-    return run(problem, solver_profile(profile, **overrides))
+    return run(problem, solver_profile(profile, **overrides), extra=extra)
 
 
 @dataclass(frozen=True)

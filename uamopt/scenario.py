@@ -321,6 +321,10 @@ class ScheduleConfig(_Section):
     max_delay_scale: Annotated[float, BeforeValidator(_number), Field(gt=0, le=1, allow_inf_nan=False)] = Field(
         1.0, description="Δd as a share of Eq. 29's bound round(L/v_g) + ΔT (Eq. 29 allows any Δd up to it)"
     )
+    departure_spacing_s: NonNegFloat = Field(
+        0.0, description="s: any two flights from one vertiport depart at least s apart (family departure_spacing, "
+        "docs/variants.md); 0: off, the paper's model"
+    )
     objective: Literal["weighted", "lexicographic"] = Field(
         "lexicographic", description="most flights first, then least total delay (default: the paper's stated aim, "
         "docs/readings.md), or \"weighted\": the literal Eq. 20, ω6 T_d − ω7 S with delays in seconds, whose optimum "

@@ -91,7 +91,10 @@ def warm_up(problems, profiles) -> None:
     problem = next(iter(problems))
     first = problem.flights.flights[0].aircraft
     tiny = dataclasses.replace(problem.flights, flights=tuple(f for f in problem.flights.flights if f.aircraft == first))
-    tiny_problem = build_problem(tiny, objective=problem.objective_kind, weights=problem.weights)
+    if problem.objective_terms is not None or problem.extra_families:  # not a flight plan's model: warm up on it
+        tiny_problem = problem
+    else:
+        tiny_problem = build_problem(tiny, objective=problem.objective_kind, weights=problem.weights)
     for profile in {p.solver: p for p in profiles}.values():
         try:
             solve(tiny_problem, profile, time_limit_s=min(5.0, profile.time_limit_s))
@@ -183,16 +186,30 @@ def cmd_bench(args) -> int:
             raise UamoptError(f"--seeds {' '.join(map(str, args.seeds))} gives no distinct seeds", "--seeds",
                               "give a count (--seeds 3 runs seeds 0, 1, 2) or two or more seeds (--seeds 0 1 2)")
     profiles = _profiles(args.solver, args.time_limit)
-    scenarios = [load_scenario(path, args.set) for path in args.scenario]
+    airland = [path for path in args.scenario if is_airland(path)]  # OR-Library landing files: instances as they are
+    if airland and (args.set or args.flights or args.network):
+        raise UamoptError("--set, --flights and --network do not apply to an airland file", airland[0],
+                          "bench airland files on their own, or scenarios with those options")
+    scenarios = {path: load_scenario(path, args.set) for path in args.scenario if path not in airland}
     with output_lock(args.out):  # held from the first instance to the written report
         instances = {}
-        for scenario in scenarios:
-            name = instance_name(scenario, args.set)
-            instances[name if name not in instances else f"{name}#{len(instances) + 1}"] = _cli_problem(scenario, args)
+        for path in args.scenario:
+            if path in airland:
+                from uamopt.schedule.airland import read_airland
+
+                name, problem = Path(path).stem, read_airland(path)
+            else:
+                name, problem = instance_name(scenarios[path], args.set), _cli_problem(scenarios[path], args)
+            instances[name if name not in instances else f"{name}#{len(instances) + 1}"] = problem
         table = benchmark(instances, profiles, seeds=seeds)
         text = write_bench(args.out, table)
     print(text)
     return 0 if bool(table["verified"].fillna(False).all()) else 1
+
+
+def is_airland(path) -> bool:
+    """An OR-Library aircraft-landing file (``airland*.txt``, or any ``.txt``): not a scenario."""
+    return Path(str(path)).suffix.lower() == ".txt"
 
 
 def _cli_problem(scenario, args):

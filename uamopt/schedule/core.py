@@ -33,9 +33,11 @@ from functools import cached_property
 import numpy as np
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Objective:
-    """W = per_delay · Σ c d − per_flight · Σ c (module docstring); ``kind`` is weighted | lexicographic.
+    """W = per_delay · Σ c d − per_flight · Σ c (module docstring), plus the per-flight
+    earliness/tardiness terms of kind ``earliness_tardiness``; ``kind`` is weighted | lexicographic
+    | earliness_tardiness.
 
     Examples
     --------
@@ -52,6 +54,11 @@ class Objective:
     #: (per_delay, per_flight) as exact fractions when the weights are decimals (CP-SAT's integer
     #: objective); None for the lexicographic kind, whose scale CP-SAT sets itself
     exact: tuple[Fraction, Fraction] | None = None
+    #: earliness_tardiness: per flight the target delay a_f and the costs per second early (e_f)
+    #: and late (l_f): an operated flight costs e_f·(a_f − d_f)⁺ + l_f·(d_f − a_f)⁺ on top
+    target_s: np.ndarray | None = None
+    early_per_s: np.ndarray | None = None
+    late_per_s: np.ndarray | None = None
 
     @classmethod
     def weighted(cls, w6: float, w7: float, aircraft: int) -> Objective:
@@ -64,15 +71,55 @@ class Objective:
         """Most flights first, then least delay: per flight 1, per second 1 / (Σ U + 1)."""
         return cls("lexicographic", 1.0 / (float(np.sum(delay_upper_s)) + 1.0), 1.0)
 
+    @classmethod
+    def earliness_tardiness(cls, target_s, early_per_s, late_per_s, per_flight: float = 0.0) -> Objective:
+        """Σ_f c_f (e_f (a_f − d_f)⁺ + l_f (d_f − a_f)⁺) − per_flight Σ c (the aircraft-landing
+        problem's cost with a_f = T_f − E_f; Beasley et al. 2000)."""
+        arrays = [np.asarray(a, dtype=float).copy() for a in (target_s, early_per_s, late_per_s)]
+        for a in arrays:
+            a.setflags(write=False)
+        return cls("earliness_tardiness", 0.0, float(per_flight), (Fraction(0), Fraction(repr(float(per_flight)))),
+                   *arrays)
+
+    @property
+    def per_flight_terms(self) -> bool:
+        """Whether the delay cost differs per flight (earliness/tardiness): not a function of Σ d."""
+        return self.target_s is not None
+
     def value(self, operated: int, total_delay_s: float) -> float:
-        """W of a decision with ``operated`` flights and ``total_delay_s`` = Σ c d."""
+        """W of a decision with ``operated`` flights and ``total_delay_s`` = Σ c d (linear kinds)."""
+        assert not self.per_flight_terms, "the earliness/tardiness objective needs the decisions: use cost()"
         return self.per_delay * total_delay_s - self.per_flight * operated
+
+    def delay_cost(self, delay_s: np.ndarray, flights: np.ndarray | slice = slice(None)) -> np.ndarray:
+        """The delay part of an operated flight's cost at ``delay_s`` (flights ``flights``)."""
+        d = np.asarray(delay_s, dtype=float)
+        out = self.per_delay * d
+        if self.per_flight_terms:
+            a = self.target_s[flights]
+            out = out + self.early_per_s[flights] * np.maximum(0.0, a - d) + self.late_per_s[flights] * np.maximum(0.0, d - a)
+        return out
+
+    def cost(self, operated: np.ndarray, delay_s: np.ndarray) -> float:
+        """W of one decision (n,) — any kind."""
+        c = np.asarray(operated, dtype=bool)
+        if not self.per_flight_terms:
+            return self.value(int(c.sum()), float(np.sum(np.where(c, np.asarray(delay_s, dtype=float), 0.0))))
+        return float(self.values(c[None, :], np.asarray(delay_s, dtype=float)[None, :])[0])
 
     def values(self, operated: np.ndarray, delay_s: np.ndarray) -> np.ndarray:
         """W of each row of (k, n) decisions (vectorised over a population)."""
         c = np.asarray(operated, dtype=bool)
-        total = np.sum(np.where(c, np.asarray(delay_s, dtype=float), 0.0), axis=-1)
-        return self.per_delay * total - self.per_flight * c.sum(axis=-1)
+        d = np.where(c, np.asarray(delay_s, dtype=float), 0.0)
+        if not self.per_flight_terms:  # Σ d first, then the weight: the linear kinds' values to the last bit
+            return self.per_delay * np.sum(d, axis=-1) - self.per_flight * c.sum(axis=-1)
+        per = np.where(c, self.delay_cost(d), 0.0)
+        return np.sum(per, axis=-1) - self.per_flight * c.sum(axis=-1)
+
+    @property
+    def preferred_delay_s(self) -> np.ndarray | float:
+        """The delay an operated flight would choose alone: its target (earliness/tardiness), else 0."""
+        return self.target_s if self.per_flight_terms else 0.0
 
     def scaled_delay(self, unit_s: float) -> Fraction:
         """The exact weight of one delay unit of ``unit_s`` seconds (weighted kind only)."""

@@ -162,6 +162,11 @@ class FlightSet:
         dep = np.array([f.planned_departure_s for f in self.flights], dtype=float)
         return tuple(_frozen(np.array(sorted(ix, key=lambda i: (dep[i], i)), dtype=np.int64)) for ix in by_aircraft.values())
 
+    @cached_property
+    def ids(self) -> tuple[str, ...]:
+        """The flight ids, in index order."""
+        return tuple(f.id for f in self.flights)
+
     @property
     def aircraft_ids(self) -> tuple[str, ...]:
         return tuple(self.flights[int(c[0])].aircraft for c in self.chains)

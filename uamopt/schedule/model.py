@@ -32,7 +32,6 @@ The objective, the pair view of the conflicts and "must operate" are defined onc
 from __future__ import annotations
 
 import csv
-import itertools
 from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
@@ -52,7 +51,7 @@ Status = Literal["optimal", "optimal_on_grid", "feasible", "time_limit", "infeas
 #: ``optimal``: proved for the continuous problem (Sec. 4.3); ``optimal_on_grid``: proved only for a
 #: restriction of it (delays on a grid or lattice, ``extras["model_kind"]``), not for continuous delays
 STATUSES = ("optimal", "optimal_on_grid", "feasible", "time_limit", "infeasible", "error")
-ObjectiveKind = Literal["weighted", "lexicographic"]
+ObjectiveKind = Literal["weighted", "lexicographic", "earliness_tardiness"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -66,10 +65,18 @@ class SchedulingProblem:
     objective_kind: ObjectiveKind = "weighted"
     time_step_s: float = 10.0  # ΔT_a (Table B.3): the heuristics' delay grid unless a profile sets step_s
     must_operate: np.ndarray | None = None  # (n,) bool: flights that may not be cancelled (core.py); None: none
+    #: families beyond the paper's five (uamopt.schedule.families), e.g. a departure spacing
+    extra_families: tuple = ()
+    #: the objective itself when it is not made from the weights (kind earliness_tardiness)
+    objective_terms: Objective | None = None
 
     def __post_init__(self) -> None:
-        if self.objective_kind not in ("weighted", "lexicographic"):
+        if self.objective_kind not in ("weighted", "lexicographic", "earliness_tardiness"):
             raise UamoptError(f"unknown objective '{self.objective_kind}'", "schedule objective", "use weighted or lexicographic")
+        if (self.objective_kind == "earliness_tardiness") != (self.objective_terms is not None):
+            raise UamoptError("objective earliness_tardiness needs its terms (objective_terms=Objective.earliness_tardiness(...))",
+                              "SchedulingProblem", "give both, or neither")
+        object.__setattr__(self, "extra_families", tuple(self.extra_families))
         if self.aircraft_count <= 0:
             object.__setattr__(self, "aircraft_count", self.flights.n_aircraft)
         must = np.zeros(len(self.flights), dtype=bool) if self.must_operate is None else np.asarray(self.must_operate, dtype=bool)
@@ -80,8 +87,33 @@ class SchedulingProblem:
         object.__setattr__(self, "must_operate", must)
 
     @cached_property
+    def families(self) -> tuple:
+        """Every constraint family of the model: the paper's five, then ``extra_families``
+        (uamopt.schedule.families)."""
+        from uamopt.schedule.families import paper_families
+
+        return paper_families(self) + self.extra_families
+
+    def of_shape(self, shape: str) -> list:
+        """The families of one shape (``pairs``, ``turnaround``, ...), in order."""
+        return [f for f in self.families if f.shape == shape]
+
+    @cached_property
+    def turnaround(self):
+        """The turnaround rows (e, f, need_s) of every ``turnaround`` family (families/turnaround.py)."""
+        from uamopt.schedule.families.turnaround import Turnaround
+
+        rows = self.of_shape("turnaround")
+        if len(rows) == 1:
+            return rows[0]
+        return Turnaround(e=np.concatenate([r.e for r in rows]), f=np.concatenate([r.f for r in rows]),
+                          need_s=np.concatenate([r.need_s for r in rows]))
+
+    @cached_property
     def objective(self) -> Objective:
         """The objective's coefficients (Eqs. 20-22 or the lexicographic scalar; core.py)."""
+        if self.objective_terms is not None:
+            return self.objective_terms
         if self.objective_kind == "lexicographic":
             return Objective.lexicographic(self.delay_upper_s)
         w6, w7 = self.weights
@@ -90,8 +122,10 @@ class SchedulingProblem:
     @cached_property
     def pairs(self) -> PairView:
         """The conflicting pairs: forbidden intervals, reach and admissible gaps of δ (core.py)."""
-        c = self.conflicts
-        return pair_view(c.p, c.q, c.ptr, c.intervals, self.planned_departure_s, self.delay_upper_s)
+        from uamopt.schedule.families.pairs import merged
+
+        p, q, ptr, intervals = merged(self.of_shape("pairs"))
+        return pair_view(p, q, ptr, intervals, self.planned_departure_s, self.delay_upper_s)
 
     @property
     def n_flights(self) -> int:
@@ -108,8 +142,13 @@ class SchedulingProblem:
 
     @cached_property
     def delay_upper_s(self) -> np.ndarray:
-        """Largest admissible delay of each flight: min(Δd, T_f − planned arrival) (Eqs. 26, 29), s."""
-        return self.flights.delay_upper_s
+        """Largest admissible delay of each flight: the least bound of every ``bounds`` family;
+        the paper's is min(Δd, T_f − planned arrival) (Eqs. 26, 29), s."""
+        bounds = [f.upper_of(self) for f in self.of_shape("bounds")]
+        out = bounds[0] if len(bounds) == 1 else np.minimum.reduce(bounds)
+        out = np.array(out, dtype=float)
+        out.setflags(write=False)
+        return out
 
     @cached_property
     def turnaround_after_s(self) -> np.ndarray:
@@ -117,8 +156,10 @@ class SchedulingProblem:
 
     @cached_property
     def requires(self) -> np.ndarray:
-        """Index of the outbound a return needs operated, −1 for outbounds."""
-        return self.flights.requires
+        """Index of the flight each flight needs operated (a return: its outbound), −1 for none
+        (the ``precedence`` family)."""
+        (family,) = self.of_shape("precedence")
+        return family.requires
 
     @cached_property
     def previous(self) -> np.ndarray:
@@ -137,58 +178,40 @@ def build_problem(
     weights: tuple[float, float] | None = None,
     objective: ObjectiveKind = "weighted",
 ) -> SchedulingProblem:
-    """Compute the pair conflicts of ``flightset`` and assemble the model.
+    """Compute the pair conflicts of ``flightset`` and assemble the model: the paper's five
+    families and any the scenario's keys switch on (uamopt.schedule.families.scenario_families).
 
     ``weights`` default to the scenario's (ω6, ω7) = (0.6, 0.4); G defaults to the number of
     distinct aircraft in the flight set (docs/interfaces.md); ΔT_a is ``schedule.time_step_s``.
     """
+    from uamopt.schedule.families import scenario_families
+
     if weights is None:
         weights = tuple(scenario.schedule.weights) if scenario is not None else (0.6, 0.4)  # type: ignore[assignment]
     return SchedulingProblem(
         flights=flightset, conflicts=conflict_table(flightset), weights=tuple(float(w) for w in weights),  # type: ignore[arg-type]
         aircraft_count=flightset.n_aircraft, objective_kind=objective,
         time_step_s=float(scenario.schedule.time_step_s) if scenario is not None else 10.0,
+        extra_families=scenario_families(flightset, scenario),
     )
 
 
 def evaluate(problem: SchedulingProblem, operated: np.ndarray, delay_s: np.ndarray) -> float:
-    """The objective of a decision (feasible or not): Eq. 20 or the lexicographic scalar."""
-    c = np.asarray(operated, dtype=bool)
-    return problem.objective.value(int(c.sum()), float(np.sum(np.where(c, np.asarray(delay_s, dtype=float), 0.0))))
+    """The objective of a decision (feasible or not): Eq. 20, the lexicographic scalar or the
+    earliness/tardiness cost."""
+    return problem.objective.cost(operated, delay_s)
 
 
 def violations(problem: SchedulingProblem, operated: np.ndarray, delay_s: np.ndarray, tol_s: float = TIME_TOL_S) -> list[str]:
-    """The model's constraints 1-4 that a decision breaks (empty: feasible).
+    """The constraints a decision breaks (empty: feasible): each family's ``violations``, in order.
 
     This checks against the model's own data; ``uamopt verify`` checks written files independently.
     """
     c = np.asarray(operated, dtype=bool)
     d = np.where(c, np.asarray(delay_s, dtype=float), 0.0)
-    ids = [f.id for f in problem.flights.flights]
     out: list[str] = []
-    for i in np.flatnonzero(c & ((d < -tol_s) | (d > problem.delay_upper_s + tol_s))):
-        out.append(f"flight {ids[i]}: delay {d[i]:g} s outside [0, {problem.delay_upper_s[i]:g}] s")
-    for i in np.flatnonzero(problem.must_operate & ~c):
-        out.append(f"flight {ids[i]}: must operate but is cancelled")
-    req = problem.requires
-    for i in np.flatnonzero(c & (req >= 0)):
-        if not c[req[i]]:
-            out.append(f"flight {ids[i]}: return operated without its outbound {ids[req[i]]}")
-    dep = problem.planned_departure_s + d
-    arr = dep + problem.flight_time_s
-    for chain in problem.chains:
-        flown = chain[c[chain]]
-        for e, f in itertools.pairwise(flown):
-            if dep[f] < arr[e] + problem.turnaround_after_s[e] - tol_s:
-                out.append(f"flight {ids[f]}: departs {dep[f]:.3f} s, before {ids[e]}'s arrival + turnaround "
-                           f"{arr[e] + problem.turnaround_after_s[e]:.3f} s")
-    view = problem.pairs
-    p, q = view.p[view.row_pair], view.q[view.row_pair]
-    delta = dep[q] - dep[p]
-    bad = c[p] & c[q] & (view.lo + tol_s < delta) & (delta < view.hi - tol_s)
-    for row in np.flatnonzero(bad):
-        out.append(f"flights {ids[p[row]]} and {ids[q[row]]}: departure gap {delta[row]:.3f} s in forbidden "
-                   f"({view.lo[row]:.3f}, {view.hi[row]:.3f})")
+    for family in problem.families:
+        out += family.violations(problem, c, d, tol_s)
     return out
 
 
@@ -299,6 +322,9 @@ def write_schedule(out_dir: str | Path, problem: SchedulingProblem, schedule: Sc
         summary["extras"] = schedule.extras
     if fs.notes:
         summary["plan_notes"] = list(fs.notes)
+    if problem.extra_families:  # what uamopt verify needs to check them from the files (verify_variants.py)
+        summary["families"] = [f.record() if hasattr(f, "record") else {"name": f.name, "shape": f.shape}
+                               for f in problem.extra_families]
     with staged_output(out_dir) as stage:
         save_flights(stage / "flights.json", fs)
         with open(stage / "schedule.csv", "w", newline="", encoding="utf-8") as fh:

@@ -32,7 +32,13 @@ def check_summary(path: Path, spec: dict, flown: list[dict], n_aircraft: int) ->
     expect = {"operated": len(flown), "cancelled": len(spec["flights"]) - len(flown),
               "total_delay_s": total, "avg_delay_s": total / n_aircraft}
     out += _off_grid(summary.get("extent_m"), spec, str(path))
-    if summary.get("status") != "infeasible" and summary.get("objective") is not None and "weights" in summary:
+    from uamopt.schedule.verify_variants import check_families
+
+    out += check_families(summary, flown, [f["id"] for f in spec["flights"]], str(path))
+    kind = summary.get("objective_kind", "weighted")
+    if kind == "earliness_tardiness":
+        pass  # checked against the instance file (verify_variants.py)
+    elif summary.get("status") != "infeasible" and summary.get("objective") is not None and "weights" in summary:
         w6, w7 = _weights(summary["weights"], str(path))
         if summary.get("objective_kind", "weighted") == "weighted":
             expect["objective"] = w6 * total / n_aircraft - w7 * len(flown)

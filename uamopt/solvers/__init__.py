@@ -104,12 +104,50 @@ def load_profile(name_or_path: str | Path) -> SolverProfile:
                          seed=raw.get("seed", 0), threads=raw.get("threads", 2), options=raw.get("options", {}))
 
 
-def solve(problem: SchedulingProblem, profile: SolverProfile | str) -> Schedule:
-    """Run the profile's solver on the problem."""
+#: solvers whose model accepts ``extra=`` callbacks (docs/variants.md): highs gets ``extra(m, problem)``
+#: on the Pyomo model, cpsat ``extra(model, problem, operate, delay)`` on the CP-SAT model
+EXTRA = ("highs", "cpsat")
+BRUTEFORCE = "uamopt.solvers.bruteforce"
+
+
+def unsupported(module, problem: SchedulingProblem) -> str | None:
+    """What of ``problem`` a solver module cannot encode: the first family whose shape (or, for a
+    solver that lists ``FAMILIES``, whose name) it lacks, or the objective kind; None if it can."""
+    for family in problem.families:
+        names = getattr(module, "FAMILIES", None)
+        if family.shape not in module.SHAPES or (names is not None and family.name not in names):
+            return f"family '{family.name}'"
+    if problem.objective.kind not in module.OBJECTIVES:
+        return f"objective '{problem.objective.kind}'"
+    return None
+
+
+def check_supported(solver: str, problem: SchedulingProblem, where: str | None = None) -> None:
+    """Refuse, before any work, a problem with a family or objective the solver has no encoder for:
+    one line naming it and the solvers that support it."""
+    module = importlib.import_module(SOLVERS[solver] if solver in SOLVERS else BRUTEFORCE)
+    missing = unsupported(module, problem)
+    if missing is None:
+        return
+    able = [name for name, path in SOLVERS.items() if unsupported(importlib.import_module(path), problem) is None]
+    raise UamoptError(f"solver {solver} has no encoder for the {missing}", where or f"solver {solver}",
+                      f"use one of: {', '.join(able)}" if able else "no solver supports this problem")
+
+
+def solve(problem: SchedulingProblem, profile: SolverProfile | str, *, extra=None) -> Schedule:
+    """Run the profile's solver on the problem.
+
+    ``extra``: a callback that adds rows to the exact model between build and solve (PyPSA's
+    ``extra_functionality``), for ``highs`` and ``cpsat`` only (:data:`EXTRA`; docs/variants.md).
+    """
     if not isinstance(profile, SolverProfile):
         profile = load_profile(profile)
+    check_supported(profile.solver, problem, f"profile {profile.name or profile.solver}")
     module = importlib.import_module(SOLVERS[profile.solver])
-    schedule = module.solve(problem, profile)
+    if extra is not None and profile.solver not in EXTRA:
+        raise UamoptError(f"solver {profile.solver} takes no extra= callback", f"profile {profile.name or profile.solver}",
+                          f"use one of {', '.join(EXTRA)}, whose models the callback can edit")
+    schedule = module.solve(problem, profile) if extra is None else module.solve(problem, profile, extra=extra)
     schedule.extras.setdefault("model_kind", model_kind(profile, problem))
     return schedule
 

@@ -31,38 +31,55 @@ from scipy.optimize import linprog
 from uamopt.errors import UamoptError
 from uamopt.schedule.model import Schedule, SchedulingProblem, make_schedule
 
+SHAPES = frozenset({"bounds", "must_operate", "precedence", "turnaround", "pairs"})  # every shape, read from the problem
+OBJECTIVES = frozenset({"weighted", "lexicographic", "earliness_tardiness"})
 MAX_FLIGHTS = 10  # 2¹⁰ operate vectors; beyond that use ``highs``
 LP_TOL = 1e-7  # the LP's own accuracy on Σ d, s
 
 
 def _lp(problem: SchedulingProblem, flown: list[int], rows: list[tuple[int, int, float]]):
-    """min Σ d over the operated flights s.t. d_i − d_j ≤ b for (i, j, b) in rows, 0 ≤ d ≤ U."""
+    """min Σ d (the linear kinds) or Σ e_f E_f + l_f L_f (earliness/tardiness, with E_f ≥ a_f − d_f,
+    L_f ≥ d_f − a_f, both ≥ 0) over the operated flights s.t. d_i − d_j ≤ b for (i, j, b) in rows,
+    0 ≤ d ≤ U. Returns (the delay part of the objective, d) or None if infeasible."""
+    o = problem.objective
+    m = len(flown)
+    extra = 2 * m if o.per_flight_terms else 0
     col = {f: k for k, f in enumerate(flown)}
-    a_ub = np.zeros((len(rows), len(flown)))
-    b_ub = np.zeros(len(rows))
+    a_ub = np.zeros((len(rows) + extra, m + extra))
+    b_ub = np.zeros(len(rows) + extra)
     for r, (i, j, b) in enumerate(rows):
         a_ub[r, col[i]] += 1.0
         a_ub[r, col[j]] -= 1.0
         b_ub[r] = b
-    res = linprog(np.ones(len(flown)), A_ub=a_ub if rows else None, b_ub=b_ub if rows else None,
-                  bounds=[(0.0, float(problem.delay_upper_s[f])) for f in flown], method="highs")
+    bounds = [(0.0, float(problem.delay_upper_s[f])) for f in flown]
+    if o.per_flight_terms:
+        cost = np.concatenate([np.zeros(m), o.early_per_s[flown], o.late_per_s[flown]])
+        for k, f in enumerate(flown):
+            r = len(rows) + 2 * k
+            a_ub[r, k], a_ub[r, m + k], b_ub[r] = -1.0, -1.0, -float(o.target_s[f])  # a − d ≤ E
+            a_ub[r + 1, k], a_ub[r + 1, 2 * m + k], b_ub[r + 1] = 1.0, -1.0, float(o.target_s[f])  # d − a ≤ L
+        bounds += [(0.0, None)] * extra
+    else:
+        cost = np.ones(m)
+    res = linprog(cost, A_ub=a_ub if len(b_ub) else None, b_ub=b_ub if len(b_ub) else None, bounds=bounds, method="highs")
     if res.status == 2:
         return None
     if res.status != 0:
         raise UamoptError(f"linprog failed: {res.message}", "bruteforce", "this is a test oracle; report it")
-    return float(res.fun), res.x
+    d = res.x[:m]
+    return (float(res.fun) if o.per_flight_terms else float(res.fun) * o.per_delay), d
 
 
 def least_delay(problem: SchedulingProblem, operated: np.ndarray) -> tuple[float, np.ndarray] | None:
-    """The least total delay and its delays for the operate vector ``operated``, or None if none is feasible."""
-    dep, time_s, gap = problem.planned_departure_s, problem.flight_time_s, problem.turnaround_after_s
+    """The least delay cost (per_delay · Σ d, or the earliness/tardiness sum) and its delays for the
+    operate vector ``operated``, or None if none is feasible."""
+    dep = problem.planned_departure_s
     flown = [int(f) for f in np.flatnonzero(operated)]
     if not flown:
         return 0.0, np.zeros(problem.n_flights)
-    fixed = []
-    for chain in problem.chains:  # dep_f ≥ dep_e + T_e + ΔT_e  ⇔  d_e − d_f ≤ D_f − D_e − T_e − ΔT_e
-        mine = [int(f) for f in chain if operated[f]]
-        fixed += [(e, f, dep[f] - dep[e] - time_s[e] - gap[e]) for i, e in enumerate(mine) for f in mine[i + 1:]]
+    t = problem.turnaround  # d_f − d_e ≥ need  ⇔  d_e − d_f ≤ −need (families/turnaround.py)
+    both = operated[t.e] & operated[t.f]
+    fixed = list(zip(t.e[both].tolist(), t.f[both].tolist(), (-t.need_s[both]).tolist()))
     branching = []
     view = problem.pairs  # the admissible-gap view (uamopt.schedule.core)
     for k, (p, q) in enumerate(zip(view.p.tolist(), view.q.tolist())):
@@ -76,10 +93,11 @@ def least_delay(problem: SchedulingProblem, operated: np.ndarray) -> tuple[float
         branching.append([[(p, q, shift - a), (q, p, b - shift)] for a, b in gaps])
     branching.sort(key=len)
     best: list = [np.inf, None]
+    tol = LP_TOL * max(problem.objective.per_delay, 1e-300) if not problem.objective.per_flight_terms else LP_TOL
 
     def dfs(depth: int, rows: list) -> None:
         found = _lp(problem, flown, rows)
-        if found is None or found[0] >= best[0] - LP_TOL:
+        if found is None or found[0] >= best[0] - tol:
             return
         if depth == len(branching):
             best[:] = list(found)
@@ -92,7 +110,9 @@ def least_delay(problem: SchedulingProblem, operated: np.ndarray) -> tuple[float
         return None
     delay = np.zeros(problem.n_flights)
     delay[flown] = np.clip(best[1], 0.0, problem.delay_upper_s[flown])
-    return float(delay.sum()), delay
+    if not problem.objective.per_flight_terms:  # the clipped delays' own Σ d
+        return problem.objective.per_delay * float(delay.sum()), delay
+    return float(problem.objective.delay_cost(delay[flown], np.asarray(flown)).sum()), delay
 
 
 def solve(problem: SchedulingProblem, profile=None) -> Schedule:
@@ -113,11 +133,11 @@ def solve(problem: SchedulingProblem, profile=None) -> Schedule:
     vectors.sort(key=lambda c: -int(c.sum()))  # stable: ties keep the product order
     best_value, best = np.inf, None
     for c in vectors:
-        if objective.value(int(c.sum()), 0.0) >= best_value - 1e-12:
-            break  # every later vector operates no more flights
+        if -objective.per_flight * int(c.sum()) >= best_value - 1e-12:
+            break  # every later vector operates no more flights, and a delay costs ≥ 0
         found = least_delay(problem, c)
-        if found is not None and objective.value(int(c.sum()), found[0]) < best_value:
-            best_value, best = objective.value(int(c.sum()), found[0]), (c, found[1])
+        if found is not None and found[0] - objective.per_flight * int(c.sum()) < best_value:
+            best_value, best = found[0] - objective.per_flight * int(c.sum()), (c, found[1])
     if best is None:  # only with must-operate flights: cancelling every other flight is always feasible
         return make_schedule(problem, "bruteforce", "infeasible", np.zeros(n, bool), np.zeros(n),
                              solve_seconds=time.perf_counter() - start, extras={"vectors": len(vectors)})

@@ -38,6 +38,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -53,11 +54,14 @@ CERTIFIED_GAP = 1e-9  # objective − continuous bound, relative, at which a lat
 
 def integer_objective(problem: SchedulingProblem, unit_s: float, delay_max: np.ndarray) -> tuple[int, int, float, str]:
     """Integer coefficients (per unit of delay, per operated flight) of ``problem.objective``, the
-    divisor back to W, and how."""
+    divisor back to W, and how (the linear kinds; earliness/tardiness: :func:`integer_terms`)."""
     total = int(delay_max.sum()) + 1
     objective = problem.objective
     if objective.exact is None:  # lexicographic: one flight outweighs every delay unit together
         return 1, total, 1.0, "lexicographic"
+    if objective.per_flight_terms:
+        _, _, _, per_flight, divisor, how = integer_terms(problem, unit_s, delay_max)
+        return 0, per_flight, divisor, how
     per_unit, per_flight = objective.scaled_delay(unit_s), objective.exact[1]
     scale = math.lcm(per_unit.denominator, per_flight.denominator)
     a, b = int(per_unit * scale), int(per_flight * scale)
@@ -67,17 +71,110 @@ def integer_objective(problem: SchedulingProblem, unit_s: float, delay_max: np.n
     return round(float(per_unit) / top * 1e9), round(float(per_flight) / top * 1e9), 1e9 / top, "approximate"
 
 
-def build_cpsat(problem: SchedulingProblem, unit_s: float = 0.01, rounding: str = "outer"):
+def integer_terms(problem: SchedulingProblem, unit_s: float, delay_max: np.ndarray):
+    """The earliness/tardiness objective on the u-lattice: (target in units (n,), early and late
+    cost per unit (n,) int, per-flight reward int, divisor back to W, how). ``how`` is ``exact`` when
+    every target is a multiple of u and the costs are decimals whose scaled sum fits int64."""
+    from fractions import Fraction
+
+    o = problem.objective
+    target = o.target_s / unit_s
+    target_k = np.rint(target).astype(np.int64)
+    fr_u = Fraction(repr(float(unit_s)))
+    early = [Fraction(repr(float(c))) * fr_u for c in o.early_per_s]
+    late = [Fraction(repr(float(c))) * fr_u for c in o.late_per_s]
+    reward = o.exact[1]
+    scale = math.lcm(*(x.denominator for x in early + late + [reward]))
+    e_int = np.array([int(x * scale) for x in early], dtype=object)
+    l_int = np.array([int(x * scale) for x in late], dtype=object)
+    worst = sum(int(a) * int(m) + int(b) * int(m) for a, b, m in zip(e_int, l_int, delay_max)) + int(reward * scale) * len(delay_max)
+    how = "exact" if np.all(np.abs(target - target_k) <= 1e-9) else "approximate"
+    if worst >= INT_LIMIT:
+        raise UamoptError("the earliness/tardiness costs overflow CP-SAT's 64-bit objective", "solver cpsat",
+                          "use a coarser time_unit_s or round the costs")
+    return target_k, e_int.astype(np.int64), l_int.astype(np.int64), int(reward * scale), float(scale), how
+
+
+@dataclass
+class _Vars:
+    """What the encoders share: the model, c_f, k_f (delay in units), the unit, the rounding."""
+
+    model: object
+    operate: list
+    delay: list
+    delay_max: np.ndarray
+    unit_s: float
+    rounding: str
+
+    @property
+    def eta(self) -> float:
+        return ROUND_S / self.unit_s
+
+
+def encode_bounds(v: _Vars, problem: SchedulingProblem, family) -> None:
+    """Shape ``bounds``: the domain 0 ≤ k_f ≤ ⌊U_f/u⌋ of the delay variables (U: every bounds family)."""
+
+
+def encode_must_operate(v: _Vars, problem: SchedulingProblem, family) -> None:
+    for f in np.flatnonzero(family.mask).tolist():
+        v.model.add(v.operate[f] == 1)
+
+
+def encode_precedence(v: _Vars, problem: SchedulingProblem, family) -> None:
+    for f in np.flatnonzero(family.requires >= 0).tolist():
+        v.model.add_implication(v.operate[f], v.operate[int(family.requires[f])])
+
+
+def encode_turnaround(v: _Vars, problem: SchedulingProblem, family=None) -> None:
+    """k_f − k_e ≥ ⌈need/u⌉ if c_e ∧ c_f, for every row of ``problem.turnaround``."""
+    t, eta, u = problem.turnaround, v.eta, v.unit_s
+    for e, f, need in zip(t.e.tolist(), t.f.tolist(), t.need_s.tolist()):
+        need = (math.ceil(need / u - eta) if v.rounding == "outer"
+                else math.floor((need - TIME_TOL_S) / u - 1 - eta) + 1)
+        if need > -v.delay_max[e]:
+            v.model.add(v.delay[f] - v.delay[e] >= need).only_enforce_if([v.operate[e], v.operate[f]])
+
+
+def encode_pairs(v: _Vars, problem: SchedulingProblem, family=None) -> None:
+    """k_q − k_p in the admissible integer set if c_p ∧ c_q, for every pair of ``problem.pairs``."""
+    from ortools.util.python.sorted_interval_list import Domain
+
+    view, eta, u, operate, delay = problem.pairs, v.eta, v.unit_s, v.operate, v.delay
+    for k, (p, q) in enumerate(zip(view.p.tolist(), view.q.tolist())):
+        shift, rows = float(view.shift[k]), slice(view.ptr[k], view.ptr[k + 1])
+        reach = Domain(-int(v.delay_max[p]), int(v.delay_max[q]))
+        if v.rounding == "outer":
+            forbidden = [[math.floor((lo - shift) / u + eta) + 1, math.ceil((hi - shift) / u - eta) - 1]
+                         for lo, hi in zip(view.lo[rows].tolist(), view.hi[rows].tolist())]
+        else:
+            forbidden = [[math.ceil((lo + TIME_TOL_S - shift) / u + 1 + eta),
+                          math.floor((hi - TIME_TOL_S - shift) / u - 1 - eta)]
+                         for lo, hi in zip(view.lo[rows].tolist(), view.hi[rows].tolist())]
+        forbidden = [iv for iv in forbidden if iv[0] <= iv[1]]
+        allowed = reach.intersection_with(Domain.from_intervals(forbidden).complement()) if forbidden else reach
+        if allowed.is_empty():
+            v.model.add_bool_or([operate[p].Not(), operate[q].Not()])
+        elif allowed.size() < reach.size():
+            v.model.add_linear_expression_in_domain(delay[q] - delay[p], allowed).only_enforce_if([operate[p], operate[q]])
+
+
+#: one encoder per family shape (uamopt.schedule.families); pairs and turnaround: the merged views, once
+ENCODERS = {"bounds": encode_bounds, "must_operate": encode_must_operate, "precedence": encode_precedence,
+            "turnaround": encode_turnaround, "pairs": encode_pairs}
+SHAPES = frozenset(ENCODERS)
+OBJECTIVES = frozenset({"weighted", "lexicographic", "earliness_tardiness"})
+
+
+def build_cpsat(problem: SchedulingProblem, unit_s: float = 0.01, rounding: str = "outer", extra=None):
     """The CP-SAT model; returns (model, operate vars, delay vars in units, per-unit coef, per-flight coef, divisor, how).
 
     ``rounding = "inner"`` reads k as the *cell* [k u, (k+1) u) of a continuous delay and forbids
     only what every point of a cell pair breaks (as timeindexed.py's ``relaxed`` model): a
-    relaxation, whose bound holds for continuous delays."""
+    relaxation, whose bound holds for continuous delays. ``extra(model, problem, operate, delay)``
+    runs after the families, before the objective (docs/variants.md)."""
     from ortools.sat.python import cp_model  # imported on use: see ``solve``
-    from ortools.util.python.sorted_interval_list import Domain
 
     eta = ROUND_S / unit_s
-    dep, time, gap = problem.planned_departure_s, problem.flight_time_s, problem.turnaround_after_s
     delay_max = np.floor(problem.delay_upper_s / unit_s + eta).astype(np.int64)
     model = cp_model.CpModel()
     n = problem.n_flights
@@ -85,49 +182,45 @@ def build_cpsat(problem: SchedulingProblem, unit_s: float = 0.01, rounding: str 
     delay = [model.new_int_var(0, int(delay_max[f]), f"k{f}") for f in range(n)]
     for f in range(n):
         model.add(delay[f] == 0).only_enforce_if(operate[f].Not())
-        if problem.requires[f] >= 0:
-            model.add_implication(operate[f], operate[int(problem.requires[f])])
-    for f in np.flatnonzero(problem.must_operate).tolist():
-        model.add(operate[f] == 1)
-    for chain in problem.chains:
-        for i, e in enumerate(chain.tolist()):
-            for f in chain[i + 1:].tolist():
-                need = dep[e] + time[e] + gap[e] - dep[f]
-                need = (math.ceil(need / unit_s - eta) if rounding == "outer"
-                        else math.floor((need - TIME_TOL_S) / unit_s - 1 - eta) + 1)
-                if need > -delay_max[e]:
-                    model.add(delay[f] - delay[e] >= need).only_enforce_if([operate[e], operate[f]])
-    view = problem.pairs
-    for k, (p, q) in enumerate(zip(view.p.tolist(), view.q.tolist())):
-        shift, rows = float(view.shift[k]), slice(view.ptr[k], view.ptr[k + 1])
-        reach = Domain(-int(delay_max[p]), int(delay_max[q]))
-        if rounding == "outer":
-            forbidden = [[math.floor((lo - shift) / unit_s + eta) + 1, math.ceil((hi - shift) / unit_s - eta) - 1]
-                         for lo, hi in zip(view.lo[rows].tolist(), view.hi[rows].tolist())]
-        else:
-            forbidden = [[math.ceil((lo + TIME_TOL_S - shift) / unit_s + 1 + eta),
-                          math.floor((hi - TIME_TOL_S - shift) / unit_s - 1 - eta)]
-                         for lo, hi in zip(view.lo[rows].tolist(), view.hi[rows].tolist())]
-        forbidden = [iv for iv in forbidden if iv[0] <= iv[1]]
-        allowed = reach.intersection_with(Domain.from_intervals(forbidden).complement()) if forbidden else reach
-        if allowed.is_empty():
-            model.add_bool_or([operate[p].Not(), operate[q].Not()])
-        elif allowed.size() < reach.size():
-            model.add_linear_expression_in_domain(delay[q] - delay[p], allowed).only_enforce_if([operate[p], operate[q]])
+    v = _Vars(model, operate, delay, delay_max, unit_s, rounding)
+    done = set()
+    for family in problem.families:
+        if family.shape in ("pairs", "turnaround"):
+            if family.shape in done:
+                continue
+            done.add(family.shape)
+        ENCODERS[family.shape](v, problem, family)
+    if extra is not None:
+        extra(model, problem, operate, delay)
     per_unit, per_flight, divisor, how = integer_objective(problem, unit_s, delay_max)
-    model.minimize(per_unit * sum(delay) - per_flight * sum(operate))
+    if problem.objective.per_flight_terms:
+        target_k, e_int, l_int, per_flight, divisor, how = integer_terms(problem, unit_s, delay_max)
+        terms = []
+        for f in range(n):  # early_f ≥ a_f − k_f and late_f ≥ k_f − a_f when operated; both ≥ 0
+            a, top = int(target_k[f]), int(delay_max[f])
+            a_early = a - 1 if rounding == "inner" else a  # a cell [k u, (k+1) u) is charged its least earliness
+            early = model.new_int_var(0, max(0, a), f"e{f}")
+            late = model.new_int_var(0, max(0, top - a), f"l{f}")
+            model.add(early >= a_early - delay[f]).only_enforce_if(operate[f])
+            model.add(late >= delay[f] - a)
+            terms += [int(e_int[f]) * early, int(l_int[f]) * late]
+        model.minimize(sum(terms) - per_flight * sum(operate))
+    else:
+        model.minimize(per_unit * sum(delay) - per_flight * sum(operate))
     return model, operate, delay, per_unit, per_flight, divisor, how
 
 
 def lattice_is_exact(problem: SchedulingProblem, unit_s: float, how: str) -> bool:
     """True when the u-lattice model has the continuous model's optimum (module docstring): every
     time of the data (planned departures, flight times, turnaround gaps, delay bounds, the pairs'
-    forbidden intervals and shifts) is a multiple of u, and the objective's integer scaling is exact."""
+    forbidden intervals and shifts, the earliness/tardiness targets) is a multiple of u, and the
+    objective's integer scaling is exact."""
     if how == "approximate":
         return False
     view = problem.pairs
-    times = [problem.planned_departure_s, problem.flight_time_s, problem.turnaround_after_s, problem.delay_upper_s,
-             view.lo, view.hi, view.shift]
+    times = [problem.planned_departure_s, problem.turnaround.need_s, problem.delay_upper_s, view.lo, view.hi, view.shift]
+    if problem.objective.per_flight_terms:  # the kinks of the cost, too (then every vertex stays on the lattice)
+        times.append(problem.objective.target_s)
     for values in times:
         units = np.asarray(values, dtype=float) / unit_s
         finite = units[np.isfinite(units)]
@@ -173,7 +266,7 @@ def _solver(profile, options: dict, limit_s: float):
     return solver
 
 
-def solve(problem: SchedulingProblem, profile) -> Schedule:
+def solve(problem: SchedulingProblem, profile, extra=None) -> Schedule:
     """Solve the discretised model with CP-SAT; status optimal | time_limit | infeasible, from CP-SAT's
     own termination (OPTIMAL: proved on the u-lattice model; FEASIBLE: stopped by the time limit,
     the only limit set). Hinted with the best cheap heuristic schedule on the ΔT_a grid
@@ -189,14 +282,16 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
 
     from ortools.sat.python import cp_model
 
-    from uamopt.solvers.warmstart import infeasible_reason, no_schedule, no_worse, reduced, warm_start
+    from uamopt.solvers.warmstart import infeasible_reason, no_schedule, no_start, no_worse, reduced, warm_start
 
     unit_s, want_bound = profile.option("time_unit_s"), profile.option("continuous_bound")
+    want_bound = want_bound and extra is None  # the callback's rows need not relax to cells: no continuous bound
     options = {k: v for k, v in profile.options.items() if k not in ("time_unit_s", "continuous_bound")}  # CP-SAT's own
     t0 = time.perf_counter()
     small = reduced(problem)  # dominance caps (warmstart.py): the same optima
-    model, operate, delay, _, per_flight, divisor, how = build_cpsat(small, unit_s)
-    start = warm_start(problem, seed=profile.seed, on_grid=True)
+    model, operate, delay, _, per_flight, divisor, how = build_cpsat(small, unit_s, extra=extra)
+    start = no_start() if extra is not None else warm_start(problem, seed=profile.seed, on_grid=True)
+    # (a heuristic schedule knows nothing of the callback's rows: no start, and no fallback to one)
     for f in range(problem.n_flights if start.found else 0):
         model.add_hint(operate[f], bool(start.operated[f]))
         model.add_hint(delay[f], int(np.rint(start.delay_s[f] / unit_s)) if start.operated[f] else 0)
@@ -235,8 +330,11 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
     schedule = no_worse(problem, make_schedule(problem, "cpsat", status, operated, delay_s,
                                                bound=lattice_bound if exact else None,
                                                solve_seconds=seconds, seed=profile.seed, extras=extras), start)
-    if want_bound and profile.time_limit_s - (time.perf_counter() - t0) > 0.5:
-        inner, i_op, i_delay, _, i_flight, i_div, i_how = build_cpsat(small, unit_s, rounding="inner")
+    if want_bound and schedule.status == "optimal" and schedule.bound is not None:  # the exact lattice's bound is continuous-valid
+        schedule.extras.update(continuous_bound=schedule.bound, continuous_bound_model="the exact lattice (lattice_exact)",
+                               optimal_within=schedule.objective - schedule.bound)
+    elif want_bound and profile.time_limit_s - (time.perf_counter() - t0) > 0.5:
+        inner, i_op, i_delay, _, i_flight, i_div, i_how = build_cpsat(small, unit_s, rounding="inner", extra=extra)
         for f in range(n):  # the outer solution is a point of the relaxation
             inner.add_hint(i_op[f], bool(operated[f]))
             inner.add_hint(i_delay[f], int(delay_k[f]))

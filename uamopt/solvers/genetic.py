@@ -53,7 +53,10 @@ import numpy as np
 
 from uamopt.errors import UamoptError
 from uamopt.schedule.model import Schedule, SchedulingProblem, make_schedule
-from uamopt.solvers.greedy import (
+from uamopt.solvers.greedy import (  # noqa: F401  (SHAPES, OBJECTIVES: the decoder's, uamopt.solvers.check_supported)
+    OBJECTIVES,
+    SHAPES,
+    base_genes,
     CANCEL,
     DEFAULT_STEP_S,
     EPS_S,
@@ -113,7 +116,8 @@ def objective_values(problem: SchedulingProblem, operated: np.ndarray, delay_s: 
     w = obj.values(operated, delay_s)
     if not problem.must_operate.any():
         return w
-    penalty = obj.per_flight * problem.n_flights + obj.per_delay * float(np.sum(problem.delay_upper_s)) + 1.0
+    worst = np.maximum(obj.delay_cost(np.zeros(problem.n_flights)), obj.delay_cost(problem.delay_upper_s))  # convex in d
+    penalty = obj.per_flight * problem.n_flights + float(np.sum(worst)) + 1.0
     return w + penalty * np.sum(problem.must_operate & ~np.asarray(operated, dtype=bool), axis=-1)
 
 
@@ -148,8 +152,9 @@ class _Population:
         return np.where(self.rng.random(flights.shape) < self.opts.cancel_prob, CANCEL, draw)
 
     def initial(self, size: int) -> np.ndarray:
-        """Individual 0: the greedy schedule (all zeros); the others perturb it at ``init_rate``."""
-        genes = np.zeros((size, self.n), dtype=np.int64)
+        """Individual 0: the greedy schedule (:func:`base_genes`: all zeros but for the
+        earliness/tardiness objective's targets); the others perturb it at ``init_rate``."""
+        genes = np.tile(base_genes(self.problem, self.opts.step_s), (size, 1))
         mask = self.rng.random((size, self.n)) < self.opts.init_rate
         mask[0] = False
         rows, cols = np.nonzero(mask)

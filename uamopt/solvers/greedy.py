@@ -57,12 +57,19 @@ class Decoder:
     partner: np.ndarray  # (K,) earlier flight of each row
     lo: np.ndarray  # (K,) s, relative to the flight's planned departure
     hi: np.ndarray  # (K,) s
+    t_ptr: np.ndarray  # (n + 1,) turnaround rows of each position (families/turnaround.py)
+    t_from: np.ndarray  # (R,) the earlier-placed flight e of each row
+    t_gap: np.ndarray  # (R,) dep_f ≥ dep_e + t_gap when both operate, s
 
     @classmethod
     def from_problem(cls, problem: SchedulingProblem, order: np.ndarray | None = None) -> Decoder:
+        """The decoder's one view of the families: the ``pairs`` shape as forbidden windows against
+        placed flights, ``turnaround`` as earliest departures after placed flights, ``precedence``,
+        ``bounds`` and ``must_operate`` read in :meth:`decode`."""
         n = problem.n_flights
-        if order is None:
-            order = np.lexsort((np.arange(n), problem.planned_departure_s, ~problem.must_operate))
+        if order is None:  # by planned departure plus the objective's preferred delay (0 but for earliness/tardiness)
+            order = np.lexsort((np.arange(n), problem.planned_departure_s + problem.objective.preferred_delay_s,
+                                ~problem.must_operate))
         order = np.asarray(order, dtype=np.int64)
         pos = np.empty(n, dtype=np.int64)
         pos[order] = np.arange(n)
@@ -78,8 +85,14 @@ class Decoder:
         rel_hi = np.where(q_later, hi, -lo) - dep0[later]
         rows = np.argsort(pos[later], kind="stable")
         counts = np.bincount(pos[later], minlength=n)
+        t = problem.turnaround
+        forward = pos[t.e] < pos[t.f]  # a row binds the later-placed flight (chains follow the order)
+        t_rows = np.flatnonzero(forward)[np.argsort(pos[t.f[forward]], kind="stable")]
+        t_counts = np.bincount(pos[t.f[t_rows]], minlength=n)
         return cls(order=order, ptr=np.concatenate([[0], np.cumsum(counts)]).astype(np.int64),
-                   partner=partner[rows], lo=rel_lo[rows], hi=rel_hi[rows])
+                   partner=partner[rows], lo=rel_lo[rows], hi=rel_hi[rows],
+                   t_ptr=np.concatenate([[0], np.cumsum(t_counts)]).astype(np.int64), t_from=t.e[t_rows],
+                   t_gap=t.gap_s(problem)[t_rows])
 
     def decode(self, problem: SchedulingProblem, genes: np.ndarray, step_s: float = DEFAULT_STEP_S,
                exact_gaps: bool = False) -> tuple[np.ndarray, np.ndarray]:
@@ -103,23 +116,26 @@ class Decoder:
         genes = np.atleast_2d(np.asarray(genes, dtype=np.int64))
         size, n = genes.shape
         dep0, upper = problem.planned_departure_s, problem.delay_upper_s
-        free_after = problem.flight_time_s + problem.turnaround_after_s  # dep_e + this ≤ next dep (Eq. 27)
-        aircraft, requires, must = problem.flights.aircraft_index, problem.requires, problem.must_operate
+        requires, must = problem.requires, problem.must_operate
         operated = np.zeros((size, n), dtype=bool)
         dep = np.zeros((size, n))
         delay = np.zeros((size, n))
-        ready = np.full((size, problem.flights.n_aircraft), -np.inf)  # earliest next departure per aircraft
 
         def snap(d: np.ndarray) -> np.ndarray:  # round a delay up to the ΔT_a grid
             return d if exact_gaps else np.ceil(d / step_s - EPS_S / step_s) * step_s
 
         for i, f in enumerate(self.order):
-            g, cap = aircraft[f], upper[f] + EPS_S
+            cap = upper[f] + EPS_S
             want = genes[:, f]
             on = (want != CANCEL) | must[f]
             if requires[f] >= 0:
                 on &= operated[:, requires[f]]  # a cancelled outbound cancels its return
-            d = snap(np.maximum(np.maximum(want, 0) * step_s, ready[:, g] - dep0[f]))
+            ta, tb = self.t_ptr[i], self.t_ptr[i + 1]
+            ready = np.full(size, -np.inf)  # earliest departure after the placed operated flights of its aircraft (Eq. 27)
+            if tb > ta:
+                e = self.t_from[ta:tb]
+                ready = np.where(operated[:, e], dep[:, e] + self.t_gap[ta:tb], -np.inf).max(axis=1)
+            d = snap(np.maximum(np.maximum(want, 0) * step_s, ready - dep0[f]))
             a, b = self.ptr[i], self.ptr[i + 1]
             if b > a:
                 others = self.partner[a:b]
@@ -137,9 +153,11 @@ class Decoder:
             operated[:, f] = on
             delay[:, f] = np.where(on, np.minimum(d, upper[f]), 0.0)
             dep[:, f] = dep0[f] + delay[:, f]
-            ready[on, g] = dep[on, f] + free_after[f]
         return operated, delay
 
+
+SHAPES = frozenset({"bounds", "must_operate", "precedence", "turnaround", "pairs"})  # the decoder's view (from_problem)
+OBJECTIVES = frozenset({"weighted", "lexicographic", "earliness_tardiness"})
 
 _DECODERS: weakref.WeakKeyDictionary[SchedulingProblem, Decoder] = weakref.WeakKeyDictionary()
 
@@ -157,8 +175,15 @@ def greedy_decisions(problem: SchedulingProblem, step_s: float | None = None, ex
     """Operated flags and delays (s) of the preliminary strategy (Sec. 5.2.1); ``step_s``
     defaults to the problem's ΔT_a."""
     step_s = problem.time_step_s if step_s is None else step_s
-    operated, delay = decoder_for(problem).decode(problem, np.zeros(problem.n_flights, dtype=np.int64), step_s, exact_gaps)
+    operated, delay = decoder_for(problem).decode(problem, base_genes(problem, step_s), step_s, exact_gaps)
     return operated[0], delay[0]
+
+
+def base_genes(problem: SchedulingProblem, step_s: float) -> np.ndarray:
+    """The preliminary strategy's chromosome: each flight wishes its preferred delay on the grid
+    (all zeros but for the earliness/tardiness objective, whose flights wish their targets)."""
+    pref = np.broadcast_to(np.asarray(problem.objective.preferred_delay_s, dtype=float), (problem.n_flights,))
+    return np.floor(pref / step_s + EPS_S / step_s).astype(np.int64)
 
 
 def solve(problem: SchedulingProblem, profile) -> Schedule:

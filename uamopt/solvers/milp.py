@@ -62,38 +62,46 @@ def admissible_gaps(problem: SchedulingProblem) -> list[tuple[int, int, list[tup
 
 
 def define_variables(m: pyo.ConcreteModel, problem: SchedulingProblem) -> None:
-    """c_f binary, 0 ≤ d_f ≤ U_f (Eqs. 26, 29) and d_f ≤ U_f c_f."""
+    """c_f binary, 0 ≤ d_f and d_f ≤ U_f c_f (U_f: the bounds families, encoded as the variable bound)."""
     upper = problem.delay_upper_s
     m.flights = pyo.RangeSet(0, problem.n_flights - 1)
     m.operate = pyo.Var(m.flights, within=pyo.Binary)
     m.delay = pyo.Var(m.flights, bounds=lambda _, f: (0.0, float(upper[f])))
     m.delay_if_operated = pyo.Constraint(m.flights, rule=lambda m, f: m.delay[f] <= float(upper[f]) * m.operate[f])
-    for f in np.flatnonzero(problem.must_operate).tolist():
-        m.operate[f].fix(1)  # must operate (core.py)
 
 
-def define_precedence(m: pyo.ConcreteModel, problem: SchedulingProblem) -> None:
+def define_bounds(m: pyo.ConcreteModel, problem: SchedulingProblem, family) -> None:
+    """Shape ``bounds`` (Eqs. 26, 29): already the variables' upper bound U_f, the least over every
+    bounds family (``problem.delay_upper_s``; define_variables)."""
+
+
+def define_must_operate(m: pyo.ConcreteModel, problem: SchedulingProblem, family) -> None:
+    """Shape ``must_operate``: c_f fixed to 1."""
+    for f in np.flatnonzero(family.mask).tolist():
+        m.operate[f].fix(1)
+
+
+def define_precedence(m: pyo.ConcreteModel, problem: SchedulingProblem, family) -> None:
     """(a) c_f ≤ c_{requires[f]}: a cancelled outbound cancels its return."""
-    returns = [int(f) for f in np.flatnonzero(problem.requires >= 0)]
-    m.precedence = pyo.Constraint(returns, rule=lambda m, f: m.operate[f] <= m.operate[int(problem.requires[f])])
+    req = family.requires
+    returns = [int(f) for f in np.flatnonzero(req >= 0)]
+    m.precedence = pyo.Constraint(returns, rule=lambda m, f: m.operate[f] <= m.operate[int(req[f])])
 
 
-def define_turnaround(m: pyo.ConcreteModel, problem: SchedulingProblem) -> None:
-    """(b) Eq. 27 for every ordered pair of one aircraft's flights, with tight big-M."""
-    dep, time, gap, upper = problem.planned_departure_s, problem.flight_time_s, problem.turnaround_after_s, problem.delay_upper_s
+def define_turnaround(m: pyo.ConcreteModel, problem: SchedulingProblem, family=None) -> None:
+    """(b) Eq. 27 for every ordered pair of one aircraft's flights (``problem.turnaround``), tight big-M."""
+    t, upper = problem.turnaround, problem.delay_upper_s
     rows = {}
-    for chain in problem.chains:
-        for i, e in enumerate(chain.tolist()):
-            for f in chain[i + 1:].tolist():
-                need = dep[e] + time[e] + gap[e] - dep[f]  # A: d_f − d_e must reach it
-                if need + upper[e] > 0:
-                    rows[e, f] = (need, max(need + upper[e], 0.0), max(need, 0.0))
+    for e, f, need in zip(t.e.tolist(), t.f.tolist(), t.need_s.tolist()):  # d_f − d_e must reach need
+        if need + upper[e] > 0:
+            rows[e, f] = (need, max(need + upper[e], 0.0), max(need, 0.0))
     m.turnaround = pyo.Constraint(list(rows), rule=lambda m, e, f: m.delay[f] - m.delay[e] >= rows[e, f][0]
                                   - rows[e, f][1] * (1 - m.operate[f]) - rows[e, f][2] * (1 - m.operate[e]))
 
 
-def define_conflicts(m: pyo.ConcreteModel, problem: SchedulingProblem) -> None:
-    """(c) the exact core: one binary per admissible gap of each conflicting pair (Eq. 24)."""
+def define_conflicts(m: pyo.ConcreteModel, problem: SchedulingProblem, family=None) -> None:
+    """(c) the exact core: one binary per admissible gap of each conflicting pair (Eq. 24), on the
+    merged view of every ``pairs`` family (``problem.pairs``)."""
     dep = problem.planned_departure_s
     m.gaps_of = admissible_gaps(problem)
     never, single, multi = [], [], []
@@ -127,19 +135,48 @@ def define_conflicts(m: pyo.ConcreteModel, problem: SchedulingProblem) -> None:
 
 
 def define_objective(m: pyo.ConcreteModel, problem: SchedulingProblem) -> None:
-    """``problem.objective`` (Eqs. 20-22 or the lexicographic scalar), with Σ d_f = Σ c_f d_f by d_f ≤ U_f c_f."""
+    """``problem.objective`` (Eqs. 20-22 or the lexicographic scalar), with Σ d_f = Σ c_f d_f by
+    d_f ≤ U_f c_f; earliness/tardiness: early_f ≥ a_f c_f − d_f and late_f ≥ d_f − a_f, both ≥ 0
+    (exact at the optimum: each is minimised with a positive cost)."""
+    o = problem.objective
     delay, flown = sum(m.delay[f] for f in m.flights), sum(m.operate[f] for f in m.flights)
-    m.objective = pyo.Objective(expr=problem.objective.per_delay * delay - problem.objective.per_flight * flown)
+    expr = o.per_delay * delay - o.per_flight * flown
+    if o.per_flight_terms:
+        a, e_cost, l_cost = o.target_s, o.early_per_s, o.late_per_s
+        m.early = pyo.Var(m.flights, bounds=(0.0, None))
+        m.late = pyo.Var(m.flights, bounds=(0.0, None))
+        m.early_row = pyo.Constraint(m.flights, rule=lambda m, f: m.early[f] >= float(a[f]) * m.operate[f] - m.delay[f])
+        m.late_row = pyo.Constraint(m.flights, rule=lambda m, f: m.late[f] >= m.delay[f] - float(a[f]))
+        expr = expr + sum(float(e_cost[f]) * m.early[f] + float(l_cost[f]) * m.late[f] for f in m.flights)
+    m.objective = pyo.Objective(expr=expr)
 
 
-def build_model(problem: SchedulingProblem) -> pyo.ConcreteModel:
-    """The Pyomo model of Eqs. 20-31 (see the module docstring), ready for any Pyomo solver."""
+#: one encoder per family shape (uamopt.schedule.families); ``pairs`` and ``turnaround`` encode the
+#: merged view of every family of their shape once
+ENCODERS = {"bounds": define_bounds, "must_operate": define_must_operate, "precedence": define_precedence,
+            "turnaround": define_turnaround, "pairs": define_conflicts}
+SHAPES = frozenset(ENCODERS)
+OBJECTIVES = frozenset({"weighted", "lexicographic", "earliness_tardiness"})
+
+
+def build_model(problem: SchedulingProblem, extra=None) -> pyo.ConcreteModel:
+    """The Pyomo model of Eqs. 20-31 (see the module docstring), ready for any Pyomo solver: the
+    variables, one encoder call per family shape, the objective, then ``extra(m, problem)`` if given
+    (PyPSA's ``extra_functionality``: add rows to ``m`` for a one-off experiment; docs/variants.md)."""
     m = pyo.ConcreteModel(name="uam_schedule")
     define_variables(m, problem)
-    define_precedence(m, problem)
-    define_turnaround(m, problem)
-    define_conflicts(m, problem)
+    done = set()
+    for family in problem.families:
+        if family.shape in ("pairs", "turnaround"):  # merged views: encoded once
+            if family.shape in done:
+                continue
+            done.add(family.shape)
+        ENCODERS[family.shape](m, problem, family)
+    if "pairs" not in done:
+        define_conflicts(m, problem)  # m.gaps_of is read by the polishing step
     define_objective(m, problem)
+    if extra is not None:
+        extra(m, problem)
     return m
 
 
@@ -149,11 +186,9 @@ def least_delays(problem: SchedulingProblem, operated: np.ndarray, chosen: dict[
     ``chosen`` maps a pair's row in ``admissible_gaps`` to its gap [g, h]. Bellman-Ford longest
     path on dep_j ≥ dep_i + w from d = 0; at most n rounds, vectorised over the edges.
     """
-    dep, time, gap, upper = problem.planned_departure_s, problem.flight_time_s, problem.turnaround_after_s, problem.delay_upper_s
-    edges = []  # (i, j, w): dep_j ≥ dep_i + w
-    for chain in problem.chains:
-        flown = [int(f) for f in chain if operated[f]]
-        edges += [(e, f, time[e] + gap[e]) for i, e in enumerate(flown) for f in flown[i + 1:]]
+    dep, upper, t = problem.planned_departure_s, problem.delay_upper_s, problem.turnaround
+    both = operated[t.e] & operated[t.f]
+    edges = list(zip(t.e[both].tolist(), t.f[both].tolist(), t.gap_s(problem)[both].tolist()))  # (i, j, w): dep_j ≥ dep_i + w
     for k, (low, high) in chosen.items():
         p, q = int(problem.pairs.p[k]), int(problem.pairs.q[k])
         edges += [(p, q, low), (q, p, -high)]  # g ≤ dep_q − dep_p ≤ h
@@ -169,6 +204,53 @@ def least_delays(problem: SchedulingProblem, operated: np.ndarray, chosen: dict[
             return delay if np.all(delay <= upper + TIME_TOL_S / 10) else None
         departure = nxt
     return None  # a positive cycle: the choices admit no delays
+
+
+def least_cost_delays(problem: SchedulingProblem, operated: np.ndarray, chosen: dict[int, tuple[float, float]]
+                      ) -> np.ndarray | None:
+    """The earliness/tardiness objective's optimal delays for fixed gap choices: the LP
+    min Σ e_f E_f + l_f L_f over the same difference constraints as :func:`least_delays`
+    (scipy's HiGHS, exact to its tolerances), or None if it fails."""
+    from scipy.optimize import linprog
+    from scipy.sparse import coo_matrix
+
+    o, t, n = problem.objective, problem.turnaround, problem.n_flights
+    flown = np.flatnonzero(operated)
+    if not len(flown):
+        return np.zeros(n)
+    col = np.full(n, -1)
+    col[flown] = np.arange(len(flown))
+    rows = []  # (i, j, b): d_i − d_j ≤ b
+    both = operated[t.e] & operated[t.f]
+    rows += list(zip(t.e[both].tolist(), t.f[both].tolist(), (-t.need_s[both]).tolist()))
+    dep = problem.planned_departure_s
+    for k, (low, high) in chosen.items():
+        p, q = int(problem.pairs.p[k]), int(problem.pairs.q[k])
+        shift = dep[q] - dep[p]
+        rows += [(p, q, shift - low), (q, p, high - shift)]
+    m = len(flown)  # variables: d (m), early (m), late (m)
+    r_i, r_j, data, b = [], [], [], []
+    for r, (i, j, bound) in enumerate(rows):
+        r_i += [r, r]
+        r_j += [col[i], col[j]]
+        data += [1.0, -1.0]
+        b.append(bound)
+    for k, f in enumerate(flown.tolist()):  # a − d − E ≤ 0 and d − a − L ≤ 0
+        base = len(rows) + 2 * k
+        r_i += [base, base, base + 1, base + 1]
+        r_j += [k, m + k, k, 2 * m + k]
+        data += [-1.0, -1.0, 1.0, -1.0]
+        b += [-float(o.target_s[f]), float(o.target_s[f])]
+    a_ub = coo_matrix((data, (r_i, r_j)), shape=(len(b), 3 * m)).tocsr()
+    cost = np.concatenate([np.full(m, o.per_delay), o.early_per_s[flown], o.late_per_s[flown]])
+    upper = problem.delay_upper_s[flown]
+    bounds = [(0.0, float(u)) for u in upper] + [(0.0, None)] * (2 * m)
+    res = linprog(cost, A_ub=a_ub, b_ub=np.array(b), bounds=bounds, method="highs")
+    if res.status != 0:
+        return None
+    delay = np.zeros(n)
+    delay[flown] = np.clip(res.x[:m], 0.0, upper)
+    return delay
 
 
 def _choices(m: pyo.ConcreteModel, operated: np.ndarray) -> dict[int, tuple[float, float]]:
@@ -201,7 +283,7 @@ def mip_start(m: pyo.ConcreteModel, problem: SchedulingProblem, operated: np.nda
     return values
 
 
-def solve(problem: SchedulingProblem, profile) -> Schedule:
+def solve(problem: SchedulingProblem, profile, extra=None) -> Schedule:
     """Build and solve the MILP with HiGHS; a linopy-style status, never an exception on a limit.
 
     Status: ``optimal`` (proved, within ``mip_rel_gap``), ``time_limit`` (limit hit; the incumbent
@@ -210,20 +292,21 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
     never returns a worse one (:func:`~uamopt.solvers.warmstart.no_worse`). The model is built on
     :func:`~uamopt.solvers.warmstart.reduced` (dominated delays cut off; the optima are unchanged).
     """
-    from uamopt.solvers.warmstart import infeasible_reason, no_schedule, no_worse, reduced, warm_start
+    from uamopt.solvers.warmstart import infeasible_reason, no_schedule, no_start, no_worse, reduced, warm_start
 
     t0 = time.perf_counter()
     options = dict(profile.options)
     options.setdefault("mip_rel_gap", 0.0)
     options.setdefault("random_seed", int(profile.seed))
-    start = warm_start(problem, seed=profile.seed)
+    start = no_start() if extra is not None else warm_start(problem, seed=profile.seed)
+    # (a heuristic schedule knows nothing of the callback's rows: no start, and no fallback to one)
     solver = SolverFactory(SOLVER_NAME)
     if solver is None or not solver.available():
         raise UamoptError("HiGHS is not available to Pyomo", f"solver {profile.name or 'highs'}", "pip install highspy")
     left = profile.time_limit_s - (time.perf_counter() - t0)
     if left <= 0 or estimated_build_s(problem) > left:  # the model could not even be built in time
         return _start_only(problem, profile, start, t0, "the MILP was not built: the time limit would not cover its build")
-    m = build_model(reduced(problem))  # delay bounds capped by dominance: the same optima (warmstart.py)
+    m = build_model(reduced(problem), extra)  # delay bounds capped by dominance: the same optima (warmstart.py)
     build_s = time.perf_counter() - t0
     solver.set_instance(m)  # the persistent interface: load the model, then hand HiGHS the MIP start
     if start.found:
@@ -238,7 +321,7 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
         result = solver.solve(m, time_limit=left, threads=int(profile.threads), solver_options=options,
                               load_solutions=False, raise_exception_on_nonoptimal_result=False)
     if _stale_solution(m, result):  # highspy 1.16: the start's values beside a better objective; solve cold
-        m = build_model(reduced(problem))
+        m = build_model(reduced(problem), extra)
         left = max(0.05, profile.time_limit_s - (time.perf_counter() - t0))
         solver = SolverFactory(SOLVER_NAME)
         with stopping(cancel(solver)):
@@ -265,7 +348,10 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
     if has_solution:
         result.solution_loader.load_vars()
         operated = np.array([pyo.value(m.operate[f]) > 0.5 for f in range(n)])
-        polished = least_delays(problem, operated, _choices(m, operated))
+        polished = (least_delays(problem, operated, _choices(m, operated)) if not problem.objective.per_flight_terms
+                    else least_cost_delays(problem, operated, _choices(m, operated)))
+        if extra is not None and polished is not None:  # rows of the callback the polishing does not know
+            polished = None
         extras["polished"] = polished is not None
         raw = np.clip([pyo.value(m.delay[f]) for f in range(n)], 0.0, problem.delay_upper_s)
         delay = polished if polished is not None else np.where(operated, raw, 0.0)
@@ -288,8 +374,7 @@ MODEL = "continuous delays (the exact MILP of Eqs. 20-31)"
 def estimated_build_s(problem: SchedulingProblem) -> float:
     """A cheap upper estimate of the seconds ``build_model`` + ``set_instance`` take: rows × rate."""
     ptr = problem.pairs.gaps[0]
-    chains = sum(len(c) * (len(c) - 1) // 2 for c in problem.chains)
-    rows = 2 * problem.n_flights + chains + 3 * int(ptr[-1]) + len(problem.pairs)
+    rows = 2 * problem.n_flights + len(problem.turnaround) + 3 * int(ptr[-1]) + len(problem.pairs)
     return rows * BUILD_S_PER_ROW
 
 

@@ -68,6 +68,10 @@ from uamopt.schedule.model import Schedule, SchedulingProblem, make_schedule, vi
 from uamopt.schedule.occupancy import ConflictTable
 from uamopt.solvers.greedy import greedy_decisions
 
+SHAPES = frozenset({"bounds", "must_operate", "precedence", "turnaround", "pairs"})
+#: its sub-problems rebuild the paper's five families from a sub flight set: no other family survives
+FAMILIES = frozenset({"delay_bounds", "must_operate", "precedence", "turnaround", "conflicts"})
+OBJECTIVES = frozenset({"weighted", "lexicographic"})  # its lower bound needs Σ d (pair_matching_bound)
 
 
 # --- the cheap lower bound ---------------------------------------------------------------------

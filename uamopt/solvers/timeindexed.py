@@ -72,6 +72,8 @@ from uamopt.schedule.model import Schedule, SchedulingProblem, make_schedule
 from uamopt.solvers.deadline import highs_can_start, interrupt_at, quiet_highs
 from uamopt.solvers.warmstart import Start, no_schedule, no_worse, reduced, warm_start
 
+SHAPES = frozenset({"bounds", "must_operate", "precedence", "turnaround", "pairs"})  # encoded in build_grid_model
+OBJECTIVES = frozenset({"weighted", "lexicographic", "earliness_tardiness"})
 ETA_S = 1e-9  # float round-off accepted when rounding a time to grid steps, s
 AUTO_HIGHS_COLUMNS = 8000  # engine "auto": HiGHS up to this many columns, "hybrid" above
 HYBRID_HIGHS_SHARE = 0.3  # engine "hybrid": this share of the time to HiGHS (no presolve), the rest to CP-SAT
@@ -130,15 +132,8 @@ def _forbidden_steps(problem: SchedulingProblem, step_s: float, kind: str, k_max
         z_lo, z_hi = np.floor(lo / s + eta) + 1, np.ceil(hi / s - eta) - 1
     else:
         z_lo, z_hi = np.ceil((lo + TIME_TOL_S) / s + 1 + eta), np.floor((hi - TIME_TOL_S) / s - 1 - eta)
-    tp, tq, need = [], [], []
-    time_, gap = problem.flight_time_s, problem.turnaround_after_s
-    for chain in problem.chains:
-        for i, e in enumerate(chain.tolist()):
-            for f in chain[i + 1:].tolist():
-                tp.append(e)
-                tq.append(f)
-                need.append(dep[e] + time_[e] + gap[e] - dep[f])  # k_f s − k_e s must reach it
-    tp, tq, need = np.array(tp, dtype=np.int64), np.array(tq, dtype=np.int64), np.array(need, dtype=float)
+    t = problem.turnaround  # rows (e, f, need): k_f s − k_e s must reach need (families/turnaround.py)
+    tp, tq, need = t.e, t.f, t.need_s
     t_hi = np.ceil(need / s - eta) - 1 if kind == "grid" else np.floor((need - TIME_TOL_S) / s - 1 - eta)
     p, q = np.concatenate([p, tp]), np.concatenate([q, tq])
     z_lo = np.concatenate([z_lo, np.full(len(tp), -np.inf)])
@@ -165,7 +160,12 @@ def build_grid_model(problem: SchedulingProblem, step_s: float = 10.0, kind: str
     start = np.concatenate([[0], np.cumsum(k_max + 1)]).astype(np.int64)
     flight_of_col = np.repeat(np.arange(n), k_max + 1)
     k_of_col = np.arange(start[-1]) - start[flight_of_col]
-    cost = problem.objective.per_delay * k_of_col * step_s - problem.objective.per_flight
+    o = problem.objective
+    if kind == "relaxed" and o.per_flight_terms:  # a cell's least cost: at the point nearest the target
+        at = np.clip(o.target_s[flight_of_col], k_of_col * step_s, (k_of_col + 1) * step_s)
+    else:  # the grid point; for the relaxed linear kinds the cell's lower end
+        at = k_of_col * step_s
+    cost = o.delay_cost(at, flight_of_col) - o.per_flight
     p, q, z_lo, z_hi = _forbidden_steps(problem, step_s, kind, k_max)
     if both_ways:
         p, q, z_lo, z_hi = np.concatenate([p, q]), np.concatenate([q, p]), np.concatenate([z_lo, -z_hi]), np.concatenate([z_hi, -z_lo])
@@ -313,7 +313,16 @@ def _cpsat(model: GridModel, problem: SchedulingProblem, deadline: float, thread
     for f in model.must.tolist():
         m.add_exactly_one(x[model.start[f]:model.start[f + 1]])
     k_of_col = np.arange(model.n_cols) - np.repeat(model.start[:-1], k_max + 1)
-    coef = (per_unit * k_of_col - per_flight).astype(np.int64).tolist()
+    if problem.objective.per_flight_terms:  # earliness/tardiness in integers (cpsat.integer_terms)
+        from uamopt.solvers.cpsat import integer_terms
+
+        target_k, e_int, l_int, per_flight, divisor, how = integer_terms(problem, model.step_s, k_max)
+        f_of_col = np.repeat(np.arange(len(k_max)), k_max + 1)
+        a = target_k[f_of_col] - (1 if model.kind == "relaxed" else 0)  # a cell is charged its least earliness
+        coef = (e_int[f_of_col] * np.maximum(0, a - k_of_col) + l_int[f_of_col] * np.maximum(0, k_of_col - target_k[f_of_col])
+                - per_flight).astype(np.int64).tolist()
+    else:
+        coef = (per_unit * k_of_col - per_flight).astype(np.int64).tolist()
     m.minimize(cp_model.LinearExpr.weighted_sum(x, coef))
     if hint is not None:
         for j in range(model.n_cols):
@@ -371,6 +380,15 @@ def run_engine(engine: str, model: GridModel, problem: SchedulingProblem, limit_
     raise UamoptError(f"unknown engine '{engine}'", "solver timeindexed", "use engine = \"auto\", \"highs\", \"cpsat\" or \"hybrid\"")
 
 
+def _grid_is_exact(problem: SchedulingProblem, step_s: float) -> bool:
+    """Whether the grid model of step s has the continuous model's optimum: the lattice test of
+    cpsat.py (every time of the data a multiple of s, the objective's integer scaling exact)."""
+    from uamopt.solvers.cpsat import integer_objective, lattice_is_exact
+
+    k_max = np.floor(problem.delay_upper_s / step_s + ETA_S / step_s).astype(np.int64)
+    return lattice_is_exact(problem, step_s, integer_objective(problem, step_s, k_max)[3])
+
+
 # --- the solver ------------------------------------------------------------------------------------
 def solve(problem: SchedulingProblem, profile) -> Schedule:
     """Build the time-indexed model, warm-start it, solve it; see the module docstring."""
@@ -422,7 +440,11 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
     # extras["restricted_bound"]; ``bound`` holds only the relaxed model's bound, when computed.
     status = "optimal_on_grid" if result.proved else "time_limit"
     extras["restricted_bound"] = result.bound
-    schedule = make_schedule(problem, "timeindexed", status, operated, delay, bound=None,
+    exact = _grid_is_exact(problem, step)  # every time on the grid: the grid's optimum and bound are the continuous ones
+    extras["grid_exact"] = exact
+    if exact and result.proved:
+        status = "optimal"
+    schedule = make_schedule(problem, "timeindexed", status, operated, delay, bound=result.bound if exact else None,
                              solve_seconds=time.perf_counter() - t0, seed=profile.seed, extras=extras)
     schedule = no_worse(problem, schedule, start)
     if cont_s > 0:

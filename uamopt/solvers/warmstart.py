@@ -142,6 +142,11 @@ def warm_start(problem: SchedulingProblem, step_s: float = DEFAULT_STEP_S, *, so
                  seconds=time.perf_counter() - t0)
 
 
+def no_start(why: str = "none (an extra= callback: a heuristic schedule need not meet its rows)") -> Start:
+    """The empty start: the solver runs cold and :func:`no_worse` has nothing to fall back on."""
+    return Start(operated=None, delay_s=None, objective=math.inf, source=why, seconds=0.0)
+
+
 def no_worse(problem: SchedulingProblem, schedule: Schedule, start: Start) -> Schedule:
     """``schedule``, or ``start`` when the solver's incumbent is worse (keeping the solver's bound).
 

@@ -1,0 +1,117 @@
+"""The independent verifier's checks of families beyond the paper's (uamopt/schedule/verify.py).
+
+``summary.json`` lists each extra family with what is needed to check it (``"families"``:
+``[{"name", "shape", ...}]``). The checks here read the files and those records only, with
+their own parsing and arithmetic; they share no code with ``uamopt.schedule.families``. A family
+the verifier does not know is a violation ("cannot be checked"), never a pass.
+
+- ``separation`` with ``airland_file`` (OR-Library aircraft landing, Beasley et al. 2000): the
+  file is read again here (its own parser; its SHA-256 must match the record), and every aircraft
+  must land (be operated) at x_i = its departure in [E_i, L_i], every pair i ≠ j must keep
+  x_j ≥ x_i + S_ij or x_i ≥ x_j + S_ji, and summary.json's objective must equal
+  Σ g_i (T_i − x_i)⁺ + h_i (x_i − T_i)⁺.
+- ``departure_spacing`` with ``spacing_s``: operated flights that start at one point (the first
+  waypoint of flights.json: one vertiport) depart at least ``spacing_s`` apart.
+"""
+
+from __future__ import annotations
+
+import hashlib
+from pathlib import Path
+
+from uamopt.errors import InputFileError
+
+TOL = 1e-6  # on landing times and the objective (relative above 1)
+
+
+def _airland(path: Path, digest: str | None, where: str) -> tuple[list[list[float]], list[list[float]]]:
+    """(per aircraft [appearance, E, T, L, g, h], separation rows) of an airland file."""
+    try:
+        data = path.read_bytes()
+    except OSError as exc:
+        raise InputFileError(f"cannot read the instance file {path}: {exc.strerror or exc}", where,
+                             "keep the airland file where the schedule was made, or solve it again") from None
+    if digest is not None and hashlib.sha256(data).hexdigest() != digest:
+        raise InputFileError(f"the instance file {path} changed since the schedule was written", where,
+                             "solve the instance again")
+    try:
+        numbers = [float(x) for x in data.decode("utf-8").split()]
+    except (UnicodeDecodeError, ValueError):
+        raise InputFileError(f"the instance file {path} is not an airland file", where, "give the OR-Library file") from None
+    count = int(numbers[0]) if numbers else 0
+    if count < 1 or len(numbers) != 2 + count * (6 + count):
+        raise InputFileError(f"the instance file {path} is not an airland file", where, "give the OR-Library file")
+    head, sep, at = [], [], 2
+    for _ in range(count):
+        head.append(numbers[at:at + 6])
+        sep.append(numbers[at + 6:at + 6 + count])
+        at += 6 + count
+    return head, sep
+
+
+def _check_airland(record: dict, summary: dict, landing: dict[str, float | None], where: str) -> list[str]:
+    head, sep = _airland(Path(str(record.get("airland_file"))), record.get("sha256"), where)
+    out = []
+    times = []
+    for i, (_, earliest, _, latest, _, _) in enumerate(head):
+        x = landing.get(f"a{i + 1}")
+        if x is None:
+            out.append(f"aircraft a{i + 1}: does not land (every aircraft of the landing problem must)")
+        elif x < earliest - TOL or x > latest + TOL:
+            out.append(f"aircraft a{i + 1}: lands at {x:g}, outside its window [{earliest:g}, {latest:g}]")
+        times.append(x)
+    for i in range(len(head)):
+        for j in range(i + 1, len(head)):
+            if times[i] is None or times[j] is None:
+                continue
+            if not (times[j] >= times[i] + sep[i][j] - TOL or times[i] >= times[j] + sep[j][i] - TOL):
+                out.append(f"aircraft a{i + 1} and a{j + 1}: land at {times[i]:g} and {times[j]:g}, closer than "
+                           f"their separation ({sep[i][j]:g} after a{i + 1}, {sep[j][i]:g} after a{j + 1})")
+    if all(x is not None for x in times) and summary.get("objective") is not None:
+        cost = sum(g * max(0.0, t - x) + h * max(0.0, x - t) for (_, _, t, _, g, h), x in zip(head, times))
+        got = summary["objective"]
+        if not isinstance(got, (int, float)) or abs(got - cost) > TOL * max(1.0, abs(cost)):
+            out.append(f"summary.json: objective = {got!r}, the landing times cost {cost:.6g} (earliness/tardiness)")
+    return out
+
+
+def _check_spacing(record: dict, flown: list[dict], where: str) -> list[str]:
+    """Operated flights from one vertiport — one first waypoint (x, y), to the millimetre — depart
+    at least ``spacing_s`` apart (sorted by departure, so neighbours suffice)."""
+    spacing = record.get("spacing_s")
+    if isinstance(spacing, bool) or not isinstance(spacing, (int, float)) or not 0 <= spacing < 1e7:
+        raise InputFileError(f"departure_spacing: spacing_s must be a number of seconds ≥ 0, got {spacing!r}", where,
+                             "rewrite it with uamopt schedule")
+    out, by_origin = [], {}
+    for f in flown:
+        by_origin.setdefault(tuple(round(v, 3) for v in f["waypoints"][0][:2]), []).append(f)
+    for origin, group in sorted(by_origin.items()):
+        group.sort(key=lambda f: f["departure"])
+        for a, b in zip(group, group[1:]):
+            if b["departure"] - a["departure"] < spacing - TOL:
+                out.append(f"flights {a['id']} and {b['id']}: leave ({origin[0]:g}, {origin[1]:g}) {b['departure'] - a['departure']:.3f} s apart, "
+                           f"less than the departure spacing {spacing:g} s")
+    return out
+
+
+def check_families(summary: dict, flown: list[dict], all_ids: list[str], where: str) -> list[str]:
+    """Violations of the extra families that ``summary`` lists (module docstring); ``flown``: the
+    verifier's operated flights (with ``departure``), ``all_ids``: every flight id of flights.json."""
+    records = summary.get("families", [])
+    if not isinstance(records, list) or not all(isinstance(r, dict) for r in records):
+        raise InputFileError("'families' is not a list of objects", where, "rewrite it with uamopt schedule")
+    departure = {f["id"]: f["departure"] for f in flown}
+    landing = {fid: departure.get(fid) for fid in all_ids}
+    out, objective_checked = [], False
+    for record in records:
+        if record.get("name") == "separation" and "airland_file" in record:
+            out += _check_airland(record, summary, landing, where)
+            objective_checked = True
+        elif record.get("name") == "departure_spacing":
+            out += _check_spacing(record, flown, where)
+        else:
+            out.append(f"summary.json: family {record.get('name')!r} cannot be checked by this verifier")
+    if summary.get("objective_kind") == "earliness_tardiness" and not objective_checked and summary.get("objective") is not None:
+        out.append("summary.json: an earliness_tardiness objective cannot be checked without its instance file")
+    return out
+
