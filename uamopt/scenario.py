@@ -321,6 +321,14 @@ class ScheduleConfig(_Section):
     max_delay_scale: Annotated[float, BeforeValidator(_number), Field(gt=0, le=1, allow_inf_nan=False)] = Field(
         1.0, description="Δd as a share of Eq. 29's bound round(L/v_g) + ΔT (Eq. 29 allows any Δd up to it)"
     )
+    speed_options: tuple[Annotated[float, BeforeValidator(_number), Field(gt=0, le=1, allow_inf_nan=False)], ...] = Field(
+        (1.0,), min_length=1, max_length=8, description="factors of the cruise speed v_g a flight may fly its track at "
+        "(speed control, docs/variants.md), e.g. [0.8, 0.9, 1.0]; each in (0, 1], distinct; [1.0]: the paper's model"
+    )
+    speed_change_cost_s: NonNegFloat = Field(
+        0.0, description="a flight flown at a factor other than 1 costs as much as this many seconds of delay "
+        "(speed control); 0: free"
+    )
     departure_spacing_s: NonNegFloat = Field(
         0.0, description="s: any two flights from one vertiport depart at least s apart (family departure_spacing, "
         "docs/variants.md); 0: off, the paper's model"

@@ -107,7 +107,7 @@ def solve_row(name: str, problem, profile, seed: int) -> dict:
     from uamopt.pipeline import solve
 
     row = {"instance": name, "flights": problem.n_flights, "aircraft": problem.aircraft_count,
-           "conflicting_pairs": len(problem.conflicts), "solver": profile.solver, "profile": profile.name or profile.solver,
+           "conflicting_pairs": len(problem.pairs), "solver": profile.solver, "profile": profile.name or profile.solver,
            "seed": seed, "threads": profile.threads, "time_limit_s": profile.time_limit_s,
            "objective_kind": problem.objective_kind}
     t0 = time.perf_counter()

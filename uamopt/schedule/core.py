@@ -59,6 +59,9 @@ class Objective:
     target_s: np.ndarray | None = None
     early_per_s: np.ndarray | None = None
     late_per_s: np.ndarray | None = None
+    #: per flight a cost of operating it, in seconds of delay (charged per_delay each; a speed
+    #: change, families/speed.py); None: none
+    operate_cost_s: np.ndarray | None = None
 
     @classmethod
     def weighted(cls, w6: float, w7: float, aircraft: int) -> Objective:
@@ -86,15 +89,30 @@ class Objective:
         """Whether the delay cost differs per flight (earliness/tardiness): not a function of Σ d."""
         return self.target_s is not None
 
+    @property
+    def linear(self) -> bool:
+        """W = per_delay · Σ c d − per_flight · Σ c exactly (no per-flight terms, no operating costs)."""
+        return self.target_s is None and self.operate_cost_s is None
+
+    def with_operate_cost(self, cost_s: np.ndarray) -> Objective:
+        """The same objective plus per-flight operating costs in seconds of delay."""
+        import dataclasses
+
+        cost = np.asarray(cost_s, dtype=float).copy()
+        cost.setflags(write=False)
+        return dataclasses.replace(self, operate_cost_s=cost)
+
     def value(self, operated: int, total_delay_s: float) -> float:
         """W of a decision with ``operated`` flights and ``total_delay_s`` = Σ c d (linear kinds)."""
-        assert not self.per_flight_terms, "the earliness/tardiness objective needs the decisions: use cost()"
+        assert self.linear, "per-flight terms or operating costs need the decisions: use cost()"
         return self.per_delay * total_delay_s - self.per_flight * operated
 
     def delay_cost(self, delay_s: np.ndarray, flights: np.ndarray | slice = slice(None)) -> np.ndarray:
         """The delay part of an operated flight's cost at ``delay_s`` (flights ``flights``)."""
         d = np.asarray(delay_s, dtype=float)
         out = self.per_delay * d
+        if self.operate_cost_s is not None:
+            out = out + self.per_delay * self.operate_cost_s[flights]
         if self.per_flight_terms:
             a = self.target_s[flights]
             out = out + self.early_per_s[flights] * np.maximum(0.0, a - d) + self.late_per_s[flights] * np.maximum(0.0, d - a)
@@ -103,7 +121,7 @@ class Objective:
     def cost(self, operated: np.ndarray, delay_s: np.ndarray) -> float:
         """W of one decision (n,) — any kind."""
         c = np.asarray(operated, dtype=bool)
-        if not self.per_flight_terms:
+        if self.linear:
             return self.value(int(c.sum()), float(np.sum(np.where(c, np.asarray(delay_s, dtype=float), 0.0))))
         return float(self.values(c[None, :], np.asarray(delay_s, dtype=float)[None, :])[0])
 
@@ -111,7 +129,7 @@ class Objective:
         """W of each row of (k, n) decisions (vectorised over a population)."""
         c = np.asarray(operated, dtype=bool)
         d = np.where(c, np.asarray(delay_s, dtype=float), 0.0)
-        if not self.per_flight_terms:  # Σ d first, then the weight: the linear kinds' values to the last bit
+        if self.linear:  # Σ d first, then the weight: the linear kinds' values to the last bit
             return self.per_delay * np.sum(d, axis=-1) - self.per_flight * c.sum(axis=-1)
         per = np.where(c, self.delay_cost(d), 0.0)
         return np.sum(per, axis=-1) - self.per_flight * c.sum(axis=-1)

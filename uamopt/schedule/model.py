@@ -67,15 +67,22 @@ class SchedulingProblem:
     must_operate: np.ndarray | None = None  # (n,) bool: flights that may not be cancelled (core.py); None: none
     #: families beyond the paper's five (uamopt.schedule.families), e.g. a departure spacing
     extra_families: tuple = ()
-    #: the objective itself when it is not made from the weights (kind earliness_tardiness)
+    #: the objective itself when it is not made from the weights and the delay bounds (kind
+    #: earliness_tardiness; speed options' operating costs)
     objective_terms: Objective | None = None
+    #: families that replace the paper's five (a model whose flights are not one plan's flights:
+    #: speed options' copies, families/speed.py); None: :func:`~uamopt.schedule.families.paper_families`
+    core_families: tuple | None = None
 
     def __post_init__(self) -> None:
         if self.objective_kind not in ("weighted", "lexicographic", "earliness_tardiness"):
             raise UamoptError(f"unknown objective '{self.objective_kind}'", "schedule objective", "use weighted or lexicographic")
-        if (self.objective_kind == "earliness_tardiness") != (self.objective_terms is not None):
+        if self.objective_kind == "earliness_tardiness" and self.objective_terms is None:
             raise UamoptError("objective earliness_tardiness needs its terms (objective_terms=Objective.earliness_tardiness(...))",
-                              "SchedulingProblem", "give both, or neither")
+                              "SchedulingProblem", "give objective_terms")
+        if self.objective_terms is not None and self.objective_terms.kind != self.objective_kind:
+            raise UamoptError(f"objective_terms is of kind {self.objective_terms.kind}, not {self.objective_kind}",
+                              "SchedulingProblem", "give terms of the problem's objective kind")
         object.__setattr__(self, "extra_families", tuple(self.extra_families))
         if self.aircraft_count <= 0:
             object.__setattr__(self, "aircraft_count", self.flights.n_aircraft)
@@ -92,7 +99,8 @@ class SchedulingProblem:
         (uamopt.schedule.families)."""
         from uamopt.schedule.families import paper_families
 
-        return paper_families(self) + self.extra_families
+        core = paper_families(self) if self.core_families is None else tuple(self.core_families)
+        return core + self.extra_families
 
     def of_shape(self, shape: str) -> list:
         """The families of one shape (``pairs``, ``turnaround``, ...), in order."""
@@ -158,8 +166,14 @@ class SchedulingProblem:
     def requires(self) -> np.ndarray:
         """Index of the flight each flight needs operated (a return: its outbound), −1 for none
         (the ``precedence`` family)."""
-        (family,) = self.of_shape("precedence")
-        return family.requires
+        out = np.full(self.n_flights, -1, dtype=np.int64)
+        for family in self.of_shape("precedence"):
+            single = family.single(self.n_flights)
+            if single is None:
+                raise AttributeError("requires: a precedence family with groups of several flights (use the family's groups)")
+            out = np.where(single >= 0, single, out)
+        out.setflags(write=False)
+        return out
 
     @cached_property
     def previous(self) -> np.ndarray:
@@ -188,6 +202,19 @@ def build_problem(
 
     if weights is None:
         weights = tuple(scenario.schedule.weights) if scenario is not None else (0.6, 0.4)  # type: ignore[assignment]
+    if scenario is not None and scenario.schedule.speed_change_cost_s > 0 and tuple(scenario.schedule.speed_options) == (1.0,):
+        from uamopt.errors import ScenarioError
+
+        raise ScenarioError("schedule.speed_change_cost_s is set but no speed other than the cruise speed is offered",
+                            "schedule.speed_change_cost_s", "set schedule.speed_options, e.g. [0.8, 0.9, 1.0], or drop the cost")
+    if scenario is not None and tuple(scenario.schedule.speed_options) != (1.0,):  # speed control (families/speed.py)
+        from uamopt.schedule.families.speed import speed_problem
+
+        factors = scenario.schedule.speed_options
+        return speed_problem(flightset, factors, change_cost_s=scenario.schedule.speed_change_cost_s,
+                             weights=tuple(float(w) for w in weights), objective=objective,
+                             time_step_s=float(scenario.schedule.time_step_s),
+                             families_of=lambda fs: scenario_families(fs, scenario))
     return SchedulingProblem(
         flights=flightset, conflicts=conflict_table(flightset), weights=tuple(float(w) for w in weights),  # type: ignore[arg-type]
         aircraft_count=flightset.n_aircraft, objective_kind=objective,
@@ -311,6 +338,13 @@ def write_schedule(out_dir: str | Path, problem: SchedulingProblem, schedule: Sc
     """
     from uamopt.outputs import staged_output, write_json
 
+    from uamopt.schedule.families.speed import collapse, speed_choice_of
+
+    choice = speed_choice_of(problem)
+    if choice is not None:  # one row per flight at its chosen speed; the choice recorded for the verifier
+        extra = dict(extra or {}, families=[choice.record()] + [f.record() if hasattr(f, "record") else {"name": f.name}
+                                                                 for f in problem.extra_families])
+        problem, schedule = collapse(problem, schedule)
     fs = problem.flights
     dep = problem.planned_departure_s + schedule.delay_s
     arr = dep + problem.flight_time_s

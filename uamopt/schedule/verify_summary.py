@@ -32,14 +32,13 @@ def check_summary(path: Path, spec: dict, flown: list[dict], n_aircraft: int) ->
     expect = {"operated": len(flown), "cancelled": len(spec["flights"]) - len(flown),
               "total_delay_s": total, "avg_delay_s": total / n_aircraft}
     out += _off_grid(summary.get("extent_m"), spec, str(path))
-    from uamopt.schedule.verify_variants import check_families
+    from uamopt.schedule.verify_variants import check_families, objective_checked_here
 
-    out += check_families(summary, flown, [f["id"] for f in spec["flights"]], str(path))
-    kind = summary.get("objective_kind", "weighted")
-    if kind == "earliness_tardiness":
-        pass  # checked against the instance file (verify_variants.py)
+    out += check_families(summary, spec, flown, str(path))
+    if objective_checked_here(summary):
+        pass  # against the instance file or the speed choice (verify_variants.py)
     elif summary.get("status") != "infeasible" and summary.get("objective") is not None and "weights" in summary:
-        w6, w7 = _weights(summary["weights"], str(path))
+        w6, w7 = read_weights(summary["weights"], str(path))
         if summary.get("objective_kind", "weighted") == "weighted":
             expect["objective"] = w6 * total / n_aircraft - w7 * len(flown)
         else:
@@ -55,7 +54,7 @@ def check_summary(path: Path, spec: dict, flown: list[dict], n_aircraft: int) ->
     return out
 
 
-def _weights(raw, where: str) -> tuple[float, float]:
+def read_weights(raw, where: str) -> tuple[float, float]:
     """(ω6, ω7) of summary.json: two finite numbers, else the folder is malformed."""
     if not isinstance(raw, list) or len(raw) != 2 or not all(
             isinstance(w, (int, float)) and not isinstance(w, bool) and math.isfinite(w) for w in raw):

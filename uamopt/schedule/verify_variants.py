@@ -10,6 +10,10 @@ the verifier does not know is a violation ("cannot be checked"), never a pass.
   must land (be operated) at x_i = its departure in [E_i, L_i], every pair i ≠ j must keep
   x_j ≥ x_i + S_ij or x_i ≥ x_j + S_ji, and summary.json's objective must equal
   Σ g_i (T_i − x_i)⁺ + h_i (x_i − T_i)⁺.
+- ``speed_choice`` with ``factors``, ``cruise_speed_mps`` and ``change_cost_s``: each operated
+  flight's speed in flights.json is an allowed factor of its cruise speed (its arrival then follows
+  from the times, checked by verify.py), and summary.json's objective, with the change costs, is
+  recomputed (lexicographic: the delay weight over every speed of every flight).
 - ``departure_spacing`` with ``spacing_s``: operated flights that start at one point (the first
   waypoint of flights.json: one vertiport) depart at least ``spacing_s`` apart.
 """
@@ -94,9 +98,51 @@ def _check_spacing(record: dict, flown: list[dict], where: str) -> list[str]:
     return out
 
 
-def check_families(summary: dict, flown: list[dict], all_ids: list[str], where: str) -> list[str]:
-    """Violations of the extra families that ``summary`` lists (module docstring); ``flown``: the
-    verifier's operated flights (with ``departure``), ``all_ids``: every flight id of flights.json."""
+def _check_speeds(record: dict, summary: dict, spec: dict, flown: list[dict], where: str) -> list[str]:
+    """Each operated flight's speed (flights.json) is an allowed factor of its cruise speed, and the
+    objective with the change costs (weights, or the lexicographic weight over every speed copy)."""
+    factors, cruise, cost = record.get("factors"), record.get("cruise_speed_mps"), record.get("change_cost_s", 0.0)
+    if not (isinstance(factors, list) and factors and all(isinstance(k, (int, float)) and 0 < k <= 1 for k in factors)
+            and isinstance(cruise, dict) and isinstance(cost, (int, float)) and cost >= 0):
+        raise InputFileError("speed_choice: factors, cruise_speed_mps or change_cost_s malformed", where,
+                             "rewrite it with uamopt schedule")
+    out, changed = [], 0
+    for f in flown:
+        v = cruise.get(f["id"])
+        if not isinstance(v, (int, float)) or v <= 0:
+            raise InputFileError(f"speed_choice: no cruise speed for flight {f['id']}", where, "rewrite it with uamopt schedule")
+        match = [k for k in factors if abs(f["speed"] - k * v) <= 1e-9 * max(1.0, v)]
+        if not match:
+            out.append(f"flight {f['id']}: flies at {f['speed']:g} m/s, not one of {factors} × its cruise speed {v:g} m/s")
+        elif match[0] != 1.0:
+            changed += 1
+    total = sum(f["delay"] for f in flown) + changed * float(cost)
+    kind = summary.get("objective_kind", "weighted")
+    if summary.get("objective") is None:
+        return out
+    if kind == "weighted":
+        from uamopt.schedule.verify_summary import read_weights
+
+        w6, w7 = read_weights(summary.get("weights"), where)
+        expect = w6 * total / len({f["aircraft"] for f in spec["flights"]}) - w7 * len(flown)
+    else:
+        upper = 0.0
+        for f in spec["flights"]:
+            v = cruise.get(f["id"], f["speed"])
+            for k in factors:
+                upper += max(0.0, min(f["max_delay"], spec["service_end_s"] - f["planned"] - f["length"] / (k * v)))
+                upper += float(cost) if k != 1.0 else 0.0
+        expect = -len(flown) + total / (upper + 1.0)
+    got = summary["objective"]
+    if not isinstance(got, (int, float)) or abs(got - expect) > TOL * max(1.0, abs(expect)):
+        out.append(f"summary.json: objective = {got!r}, the schedule at its speeds gives {expect:.6g}")
+    return out
+
+
+def check_families(summary: dict, spec: dict, flown: list[dict], where: str) -> list[str]:
+    """Violations of the extra families that ``summary`` lists (module docstring); ``spec``: the
+    verifier's reading of flights.json, ``flown``: its operated flights (with ``departure``)."""
+    all_ids = [f["id"] for f in spec["flights"]]
     records = summary.get("families", [])
     if not isinstance(records, list) or not all(isinstance(r, dict) for r in records):
         raise InputFileError("'families' is not a list of objects", where, "rewrite it with uamopt schedule")
@@ -109,9 +155,19 @@ def check_families(summary: dict, flown: list[dict], all_ids: list[str], where: 
             objective_checked = True
         elif record.get("name") == "departure_spacing":
             out += _check_spacing(record, flown, where)
+        elif record.get("name") == "speed_choice":
+            out += _check_speeds(record, summary, spec, flown, where)
+            objective_checked = True
         else:
             out.append(f"summary.json: family {record.get('name')!r} cannot be checked by this verifier")
     if summary.get("objective_kind") == "earliness_tardiness" and not objective_checked and summary.get("objective") is not None:
         out.append("summary.json: an earliness_tardiness objective cannot be checked without its instance file")
     return out
+
+
+def objective_checked_here(summary: dict) -> bool:
+    """Whether this module checks summary.json's objective (then the generic check does not)."""
+    records = summary.get("families", [])
+    return summary.get("objective_kind") == "earliness_tardiness" or (
+        isinstance(records, list) and any(isinstance(r, dict) and r.get("name") == "speed_choice" for r in records))
 

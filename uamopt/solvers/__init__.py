@@ -147,9 +147,45 @@ def solve(problem: SchedulingProblem, profile: SolverProfile | str, *, extra=Non
     if extra is not None and profile.solver not in EXTRA:
         raise UamoptError(f"solver {profile.solver} takes no extra= callback", f"profile {profile.name or profile.solver}",
                           f"use one of {', '.join(EXTRA)}, whose models the callback can edit")
+    from uamopt.schedule.families.speed import speed_choice_of
+
+    choice = speed_choice_of(problem)
+    if choice is not None and profile.solver in SPEED_FIRST and extra is None:
+        return _speed_solve(problem, profile, module, choice)
     schedule = module.solve(problem, profile) if extra is None else module.solve(problem, profile, extra=extra)
     schedule.extras.setdefault("model_kind", model_kind(profile, problem))
     return schedule
+
+
+#: exact solvers that solve the cruise-speed model first when a problem has speed options, and
+#: start the speed model from its schedule (never worse than flying every flight at v_g)
+SPEED_FIRST = ("highs", "cpsat", "timeindexed")
+SPEED_BASE_SHARE = 0.4  # of the time limit, for the cruise-speed model
+
+
+def _speed_solve(problem, profile, module, choice):
+    """The speed-options model, started from the cruise-speed model's schedule (module
+    ``families/speed.py``): the base gets ``SPEED_BASE_SHARE`` of the time limit, the copies the rest."""
+    import dataclasses
+    import time
+
+    from uamopt.solvers.warmstart import SEEDS
+
+    t0 = time.perf_counter()
+    base_profile = dataclasses.replace(profile, time_limit_s=SPEED_BASE_SHARE * profile.time_limit_s)
+    first = module.solve(choice.base_problem, base_profile)
+    lifted = choice.lift(first.operated, first.delay_s) if first.status != "infeasible" else None
+    left = max(0.1, profile.time_limit_s - (time.perf_counter() - t0))
+    if lifted is not None:
+        SEEDS[id(problem)] = [("cruise-speed model", *lifted)]
+    try:
+        schedule = module.solve(problem, dataclasses.replace(profile, time_limit_s=left))
+    finally:
+        SEEDS.pop(id(problem), None)
+    schedule.extras.update(cruise_speed_model={"status": first.status, "objective": first.objective,
+                                               "operated": first.operated_count, "total_delay_s": first.total_delay_s})
+    schedule.extras.setdefault("model_kind", model_kind(profile, problem))
+    return dataclasses.replace(schedule, solve_seconds=time.perf_counter() - t0)
 
 
 def model_kind(profile: SolverProfile, problem: SchedulingProblem) -> str:

@@ -110,8 +110,10 @@ def least_delay(problem: SchedulingProblem, operated: np.ndarray) -> tuple[float
         return None
     delay = np.zeros(problem.n_flights)
     delay[flown] = np.clip(best[1], 0.0, problem.delay_upper_s[flown])
-    if not problem.objective.per_flight_terms:  # the clipped delays' own Σ d
-        return problem.objective.per_delay * float(delay.sum()), delay
+    o = problem.objective
+    fixed_cost = 0.0 if o.operate_cost_s is None else o.per_delay * float(np.sum(o.operate_cost_s[flown]))
+    if not o.per_flight_terms:  # the clipped delays' own Σ d
+        return o.per_delay * float(delay.sum()) + fixed_cost, delay
     return float(problem.objective.delay_cost(delay[flown], np.asarray(flown)).sum()), delay
 
 
@@ -127,9 +129,10 @@ def solve(problem: SchedulingProblem, profile=None) -> Schedule:
     if n > MAX_FLIGHTS:
         raise UamoptError(f"{n} flights is too many for the brute force", "bruteforce", f"use at most {MAX_FLIGHTS} or the highs solver")
     start = time.perf_counter()
-    requires, must, objective = problem.requires, problem.must_operate, problem.objective
+    must, objective = problem.must_operate, problem.objective
+    groups = [g for family in problem.of_shape("precedence") for g in family.groups()]
     vectors = [np.array(c, dtype=bool) for c in itertools.product((True, False), repeat=n)]
-    vectors = [c for c in vectors if all(requires[f] < 0 or c[requires[f]] for f in np.flatnonzero(c)) and c[must].all()]
+    vectors = [c for c in vectors if all(not c[f] or c[group].any() for f, group in groups) and c[must].all()]
     vectors.sort(key=lambda c: -int(c.sum()))  # stable: ties keep the product order
     best_value, best = np.inf, None
     for c in vectors:

@@ -55,8 +55,8 @@ CERTIFIED_GAP = 1e-9  # objective − continuous bound, relative, at which a lat
 def integer_objective(problem: SchedulingProblem, unit_s: float, delay_max: np.ndarray) -> tuple[int, int, float, str]:
     """Integer coefficients (per unit of delay, per operated flight) of ``problem.objective``, the
     divisor back to W, and how (the linear kinds; earliness/tardiness: :func:`integer_terms`)."""
-    total = int(delay_max.sum()) + 1
     objective = problem.objective
+    total = int(delay_max.sum()) + int(operate_units(problem, unit_s).sum()) + 1
     if objective.exact is None:  # lexicographic: one flight outweighs every delay unit together
         return 1, total, 1.0, "lexicographic"
     if objective.per_flight_terms:
@@ -69,6 +69,12 @@ def integer_objective(problem: SchedulingProblem, unit_s: float, delay_max: np.n
         return a, b, float(scale), "exact"
     top = max(float(per_unit), float(per_flight))
     return round(float(per_unit) / top * 1e9), round(float(per_flight) / top * 1e9), 1e9 / top, "approximate"
+
+
+def operate_units(problem: SchedulingProblem, unit_s: float) -> np.ndarray:
+    """(n,) the objective's operating cost of each flight in delay units (0 without one), rounded."""
+    cost = problem.objective.operate_cost_s
+    return np.zeros(problem.n_flights, dtype=np.int64) if cost is None else np.rint(cost / unit_s).astype(np.int64)
 
 
 def integer_terms(problem: SchedulingProblem, unit_s: float, delay_max: np.ndarray):
@@ -121,8 +127,8 @@ def encode_must_operate(v: _Vars, problem: SchedulingProblem, family) -> None:
 
 
 def encode_precedence(v: _Vars, problem: SchedulingProblem, family) -> None:
-    for f in np.flatnonzero(family.requires >= 0).tolist():
-        v.model.add_implication(v.operate[f], v.operate[int(family.requires[f])])
+    for f, group in family.groups():  # c_f ⇒ some c_g of its group (one in the paper: the outbound)
+        v.model.add_bool_or([v.operate[f].Not()] + [v.operate[int(g)] for g in group])
 
 
 def encode_turnaround(v: _Vars, problem: SchedulingProblem, family=None) -> None:
@@ -206,7 +212,9 @@ def build_cpsat(problem: SchedulingProblem, unit_s: float = 0.01, rounding: str 
             terms += [int(e_int[f]) * early, int(l_int[f]) * late]
         model.minimize(sum(terms) - per_flight * sum(operate))
     else:
-        model.minimize(per_unit * sum(delay) - per_flight * sum(operate))
+        extra_units = operate_units(problem, unit_s)  # per-flight operating costs (a speed change), in delay units
+        model.minimize(per_unit * sum(delay) - per_flight * sum(operate)
+                       + per_unit * sum(int(c) * operate[f] for f, c in enumerate(extra_units.tolist()) if c))
     return model, operate, delay, per_unit, per_flight, divisor, how
 
 
@@ -221,6 +229,8 @@ def lattice_is_exact(problem: SchedulingProblem, unit_s: float, how: str) -> boo
     times = [problem.planned_departure_s, problem.turnaround.need_s, problem.delay_upper_s, view.lo, view.hi, view.shift]
     if problem.objective.per_flight_terms:  # the kinks of the cost, too (then every vertex stays on the lattice)
         times.append(problem.objective.target_s)
+    if problem.objective.operate_cost_s is not None:
+        times.append(problem.objective.operate_cost_s)
     for values in times:
         units = np.asarray(values, dtype=float) / unit_s
         finite = units[np.isfinite(units)]

@@ -116,7 +116,11 @@ class Decoder:
         genes = np.atleast_2d(np.asarray(genes, dtype=np.int64))
         size, n = genes.shape
         dep0, upper = problem.planned_departure_s, problem.delay_upper_s
-        requires, must = problem.requires, problem.must_operate
+        must = problem.must_operate
+        needs: dict[int, list] = {}  # precedence groups of each flight (one in the paper: the outbound)
+        for family in problem.of_shape("precedence"):
+            for f_, group in family.groups():
+                needs.setdefault(f_, []).append(group)
         operated = np.zeros((size, n), dtype=bool)
         dep = np.zeros((size, n))
         delay = np.zeros((size, n))
@@ -128,8 +132,8 @@ class Decoder:
             cap = upper[f] + EPS_S
             want = genes[:, f]
             on = (want != CANCEL) | must[f]
-            if requires[f] >= 0:
-                on &= operated[:, requires[f]]  # a cancelled outbound cancels its return
+            for group in needs.get(int(f), ()):
+                on &= operated[:, group].any(axis=1)  # a cancelled outbound cancels its return
             ta, tb = self.t_ptr[i], self.t_ptr[i + 1]
             ready = np.full(size, -np.inf)  # earliest departure after the placed operated flights of its aircraft (Eq. 27)
             if tb > ta:

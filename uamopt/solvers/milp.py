@@ -82,10 +82,10 @@ def define_must_operate(m: pyo.ConcreteModel, problem: SchedulingProblem, family
 
 
 def define_precedence(m: pyo.ConcreteModel, problem: SchedulingProblem, family) -> None:
-    """(a) c_f ≤ c_{requires[f]}: a cancelled outbound cancels its return."""
-    req = family.requires
-    returns = [int(f) for f in np.flatnonzero(req >= 0)]
-    m.precedence = pyo.Constraint(returns, rule=lambda m, f: m.operate[f] <= m.operate[int(req[f])])
+    """(a) c_f ≤ Σ_{g ∈ group} c_g: a cancelled outbound cancels its return (groups of one in the paper)."""
+    rows = family.groups()
+    block = pyo.Constraint(range(len(rows)), rule=lambda m, r: m.operate[rows[r][0]] <= sum(m.operate[int(g)] for g in rows[r][1]))
+    m.add_component(family.name if not hasattr(m, family.name) else f"{family.name}_{len(m.component_map())}", block)
 
 
 def define_turnaround(m: pyo.ConcreteModel, problem: SchedulingProblem, family=None) -> None:
@@ -141,6 +141,8 @@ def define_objective(m: pyo.ConcreteModel, problem: SchedulingProblem) -> None:
     o = problem.objective
     delay, flown = sum(m.delay[f] for f in m.flights), sum(m.operate[f] for f in m.flights)
     expr = o.per_delay * delay - o.per_flight * flown
+    if o.operate_cost_s is not None:  # per-flight operating costs in seconds of delay (a speed change)
+        expr = expr + o.per_delay * sum(float(o.operate_cost_s[f]) * m.operate[f] for f in m.flights)
     if o.per_flight_terms:
         a, e_cost, l_cost = o.target_s, o.early_per_s, o.late_per_s
         m.early = pyo.Var(m.flights, bounds=(0.0, None))

@@ -6,7 +6,8 @@ Binary x_{f,k} = 1: flight f operates with delay index k ∈ {0, …, K_f}, K_f 
 29); all x_{f,·} = 0 cancels f. Rows:
 
 - assignment    Σ_k x_{f,k} ≤ 1 (c_f = Σ_k x_{f,k});
-- precedence    Σ_k x_{f,k} ≤ Σ_k x_{r,k}, r = requires[f]: a cancelled outbound cancels its return;
+- precedence    Σ_k x_{f,k} ≤ Σ_{r ∈ group} Σ_k x_{r,k} (group: the outbound, or any copy of it with speed
+  options): a cancelled outbound cancels its return;
 - pair rows     for a pair (p, q) whose index difference z = k_q − k_p may not lie in a set Z
   (a union of integer intervals): for every a, x_{p,a} + Σ_{b ∈ a + Z} x_{q,b} ≤ 1 — the
   *aggregated* conflict inequality, exact for 0-1 points because Σ_b x_{q,b} ≤ 1, and far tighter
@@ -89,7 +90,7 @@ class GridModel:
     cost: np.ndarray  # (N,) objective coefficient per column
     row_ptr: np.ndarray  # pair and assignment rows (all "≤ 1", coefficients 1): CSR
     row_col: np.ndarray
-    prec: np.ndarray  # (m, 2): (f, r) with Σ x_f ≤ Σ x_r
+    prec: list  # [(f, group)]: Σ x_f ≤ Σ_{r ∈ group} Σ x_r (families/turnaround.py Precedence)
     must: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))  # flights with Σ x_f = 1 (core.py)
 
     @property
@@ -195,8 +196,7 @@ def build_grid_model(problem: SchedulingProblem, step_s: float = 10.0, kind: str
     assign_ptr = np.concatenate([[0], np.cumsum(k_max[multi] + 1)]).astype(np.int64)
     row_ptr = np.concatenate([assign_ptr, assign_ptr[-1] + pair_ptr[1:]])
     row_col = np.concatenate([assign_cols, col]).astype(np.int64)
-    req = problem.requires
-    prec = np.stack([np.flatnonzero(req >= 0), req[req >= 0]], axis=1).astype(np.int64)
+    prec = [(f, group) for family in problem.of_shape("precedence") for f, group in family.groups()]
     return GridModel(step_s=float(step_s), kind=kind, start=start, cost=cost, row_ptr=row_ptr, row_col=row_col, prec=prec,
                      must=np.flatnonzero(problem.must_operate).astype(np.int64))
 
@@ -247,9 +247,12 @@ def _highs(model: GridModel, deadline: float, threads: int, seed: int, gap: floa
               model.row_col.astype(np.int32), np.ones(len(model.row_col)))
     if len(model.prec):  # Σ x_f − Σ x_r ≤ 0
         cols, vals, ptr = [], [], [0]
-        for f, r in model.prec.tolist():
-            cols += list(range(model.start[f], model.start[f + 1])) + list(range(model.start[r], model.start[r + 1]))
-            vals += [1.0] * int(model.start[f + 1] - model.start[f]) + [-1.0] * int(model.start[r + 1] - model.start[r])
+        for f, group in model.prec:
+            cols += list(range(model.start[f], model.start[f + 1]))
+            vals += [1.0] * int(model.start[f + 1] - model.start[f])
+            for r in group.tolist():
+                cols += list(range(model.start[r], model.start[r + 1]))
+                vals += [-1.0] * int(model.start[r + 1] - model.start[r])
             ptr.append(len(cols))
         k = len(model.prec)
         h.addRows(k, np.full(k, -inf), np.zeros(k), len(cols), np.array(ptr[:-1], dtype=np.int32),
@@ -308,8 +311,8 @@ def _cpsat(model: GridModel, problem: SchedulingProblem, deadline: float, thread
         if r % 20000 == 19999 and time.perf_counter() > deadline:  # the limit ran out while loading the model
             return EngineResult(x=None, bound=None, proved=False, termination="not run (the limit ran out building)",
                                 seconds=0.0)
-    for f, r in model.prec.tolist():
-        m.add(sum(x[model.start[f]:model.start[f + 1]]) <= sum(x[model.start[r]:model.start[r + 1]]))
+    for f, group in model.prec:
+        m.add(sum(x[model.start[f]:model.start[f + 1]]) <= sum(x[j] for r in group.tolist() for j in range(model.start[r], model.start[r + 1])))
     for f in model.must.tolist():
         m.add_exactly_one(x[model.start[f]:model.start[f + 1]])
     k_of_col = np.arange(model.n_cols) - np.repeat(model.start[:-1], k_max + 1)
@@ -322,7 +325,10 @@ def _cpsat(model: GridModel, problem: SchedulingProblem, deadline: float, thread
         coef = (e_int[f_of_col] * np.maximum(0, a - k_of_col) + l_int[f_of_col] * np.maximum(0, k_of_col - target_k[f_of_col])
                 - per_flight).astype(np.int64).tolist()
     else:
-        coef = (per_unit * k_of_col - per_flight).astype(np.int64).tolist()
+        from uamopt.solvers.cpsat import operate_units
+
+        f_of_col = np.repeat(np.arange(len(k_max)), k_max + 1)
+        coef = (per_unit * (k_of_col + operate_units(problem, model.step_s)[f_of_col]) - per_flight).astype(np.int64).tolist()
     m.minimize(cp_model.LinearExpr.weighted_sum(x, coef))
     if hint is not None:
         for j in range(model.n_cols):

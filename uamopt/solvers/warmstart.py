@@ -90,7 +90,8 @@ def reduced(problem: SchedulingProblem) -> SchedulingProblem:
 
     Evaluate schedules with the original problem (the lexicographic scalar uses Σ U; it is returned
     unchanged)."""
-    if problem.objective_kind != "weighted" or problem.objective.per_delay <= 0:
+    if problem.objective_kind != "weighted" or problem.objective.per_delay <= 0 \
+            or problem.core_families is not None:  # its dependants are the paper's precedence (speed copies: groups)
         return problem
     req = problem.requires
     dependants = np.zeros(problem.n_flights, dtype=np.int64)
@@ -109,12 +110,20 @@ def reduced(problem: SchedulingProblem) -> SchedulingProblem:
     return dataclasses.replace(problem, flights=dataclasses.replace(fs, flights=flights))
 
 
+#: schedules handed to the next warm_start of a problem (uamopt.solvers.solve: speed options start
+#: from the cruise-speed model's schedule); keyed by id(problem), consumed by warm_start
+SEEDS: dict[int, list] = {}
+
+
 def warm_start(problem: SchedulingProblem, step_s: float = DEFAULT_STEP_S, *, soa_s: float = 0.0, seed: int = 0,
                on_grid: bool = False) -> Start:
-    """The best of the cheap heuristic schedules (module docstring); always feasible."""
+    """The best of the cheap heuristic schedules (module docstring), and of any schedule seeded for
+    this problem (:data:`SEEDS`); always feasible."""
     t0 = time.perf_counter()
     small = reduced(problem)
     candidates = [("greedy", *greedy_decisions(problem, step_s))]
+    candidates += [(name, op, d) for name, op, d in SEEDS.get(id(problem), ())
+                   if not on_grid or np.allclose(np.where(op, d, 0.0) / step_s, np.rint(np.where(op, d, 0.0) / step_s))]
     if small is not problem:
         candidates.append(("greedy-capped", *greedy_decisions(small, step_s)))
     if not on_grid:

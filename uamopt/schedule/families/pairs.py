@@ -46,7 +46,7 @@ class PairIntervals:
                 record_data: dict | None = None) -> PairIntervals:
         """From rows (a, b, lo, hi): dep_b − dep_a ∉ (lo, hi), any order of a and b (flipped to a < b)."""
         fixed = sorted((a, b, lo, hi) if a < b else (b, a, -hi, -lo) for a, b, lo, hi in rows)
-        return cls.of_table(name, *_compress(fixed), description=description, record_data=record_data)
+        return cls.of_table(name, *compress_rows(fixed), description=description, record_data=record_data)
 
     def __len__(self) -> int:
         return len(self.p)
@@ -63,7 +63,7 @@ class PairIntervals:
                 f"({self.lo[r]:.3f}, {self.hi[r]:.3f}) ({self.name})" for r in np.flatnonzero(bad)]
 
 
-def _compress(rows: list[tuple[int, int, float, float]]):
+def compress_rows(rows: list[tuple[int, int, float, float]]):
     """Sorted rows (p, q, lo, hi) → (p, q, ptr, intervals) with each pair's intervals merged where
     they overlap (open intervals that only touch stay apart: the shared end is allowed)."""
     p_out, q_out, ptr, iv = [], [], [0], []
@@ -102,4 +102,4 @@ def merged(families) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     for f in families:
         row_pair = np.repeat(np.arange(len(f.p)), np.diff(f.ptr))
         rows += list(zip(f.p[row_pair].tolist(), f.q[row_pair].tolist(), f.lo.tolist(), f.hi.tolist()))
-    return _compress(sorted(rows))
+    return compress_rows(sorted(rows))

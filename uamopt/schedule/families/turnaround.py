@@ -27,9 +27,9 @@ class Turnaround:
     e: np.ndarray  # (R,) int64, the earlier flight of the aircraft
     f: np.ndarray  # (R,) int64, a later flight of the same aircraft
     need_s: np.ndarray  # (R,) s
-    name = "turnaround"
+    name: str = "turnaround"
+    description: str = "turnaround (Eqs. 27-28): a flight departs ΔT after its aircraft's previous operated arrival"
     shape = "turnaround"
-    description = "turnaround (Eqs. 27-28): a flight departs ΔT after its aircraft's previous operated arrival"
 
     @classmethod
     def of(cls, flightset) -> Turnaround:
@@ -61,19 +61,42 @@ class Turnaround:
 
 @dataclass(frozen=True, eq=False)
 class Precedence:
-    """Flight f may operate only if ``requires[f]`` does (−1: no requirement)."""
+    """Row r: flight ``flight[r]`` may operate only if one of ``idx[ptr[r]:ptr[r+1]]`` does (the
+    paper: a return needs its outbound, groups of one; with speed options, any copy of it)."""
 
-    requires: np.ndarray  # (n,) int64
-    name = "precedence"
+    flight: np.ndarray  # (m,) int64
+    ptr: np.ndarray  # (m + 1,) int64
+    idx: np.ndarray  # (K,) int64
+    name: str = "precedence"
+    description: str = "precedence: a return operates only if its outbound does"
     shape = "precedence"
-    description = "precedence: a return operates only if its outbound does"
 
     @classmethod
     def of(cls, flightset) -> Precedence:
-        return cls(requires=flightset.requires)
+        return cls.of_requires(flightset.requires)
+
+    @classmethod
+    def of_requires(cls, requires: np.ndarray, **kw) -> Precedence:
+        """Groups of one from an (n,) array of required flights (−1: none)."""
+        flight = np.flatnonzero(np.asarray(requires) >= 0).astype(np.int64)
+        return cls(flight=flight, ptr=np.arange(len(flight) + 1, dtype=np.int64),
+                   idx=np.asarray(requires, dtype=np.int64)[flight], **kw)
+
+    def groups(self):
+        """(f, required group) per row."""
+        return [(int(f), self.idx[self.ptr[r]:self.ptr[r + 1]]) for r, f in enumerate(self.flight.tolist())]
+
+    def single(self, n: int) -> np.ndarray | None:
+        """(n,) the one flight each flight requires (−1: none) when every group has one member, else None."""
+        if np.any(np.diff(self.ptr) != 1):
+            return None
+        out = np.full(n, -1, dtype=np.int64)
+        out[self.flight] = self.idx
+        return out
 
     def violations(self, problem, operated, delay_s, tol_s) -> list[str]:
         c = np.asarray(operated, dtype=bool)
-        ids, req = problem.flights.ids, self.requires
-        return [f"flight {ids[i]}: return operated without its outbound {ids[req[i]]}"
-                for i in np.flatnonzero(c & (req >= 0)) if not c[req[i]]]
+        ids = problem.flights.ids
+        return [f"flight {ids[f]}: operated without {' or '.join(ids[g] for g in group)} ({self.name})"
+                if len(group) > 1 else f"flight {ids[f]}: return operated without its outbound {ids[group[0]]}"
+                for f, group in self.groups() if c[f] and not c[group].any()]
