@@ -56,7 +56,8 @@ def landing_times(problem, schedule) -> np.ndarray:
 def test_published_optimum_proved(k, solver):
     problem = ua.read_airland(DATA / f"airland{k}.txt")
     options = {"time_unit_s": 1.0} if solver == "cpsat" else {}
-    schedule = ua.solve(problem, solver, time_limit_s=60, options=options)
+    # a limit with room for a loaded CI machine; the times measured alone are in docs/variants.md
+    schedule = ua.solve(problem, solver, time_limit_s=240 if k in SLOW else 60, options=options)
     assert schedule.status == "optimal"
     assert landing_cost(k, landing_times(problem, schedule)) == pytest.approx(PUBLISHED[k], abs=1e-6)
     assert schedule.objective == pytest.approx(PUBLISHED[k], abs=1e-6)
