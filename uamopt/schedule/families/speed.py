@@ -113,8 +113,8 @@ def speed_problem(flightset, factors, *, change_cost_s: float = 0.0, weights=(0.
             for b in index[i][x + 1:]]  # δ = 0 ± the delays: the whole reachable range is forbidden
     record = {"factors": list(order), "change_cost_s": float(change_cost_s),
               "cruise_speed_mps": {f.id: f.speed_mps for f in base.flights}}
-    choice = SpeedChoice.of_table("speed_choice", *_table(rows), record_data=record,
-                                  description="speed choice: one speed per flight (copies of a flight never both operate)")
+    choice = SpeedChoice.of_rows("speed_choice", rows, record_data=record,
+                                 description="speed choice: one speed per flight (copies of a flight never both operate)")
     plain = SchedulingProblem(flights=base, conflicts=conflict_table(base), weights=tuple(float(w) for w in weights),
                               aircraft_count=base.n_aircraft, objective_kind=objective, time_step_s=time_step_s,
                               extra_families=tuple(families_of(base)))
@@ -152,12 +152,6 @@ def speed_problem(flightset, factors, *, change_cost_s: float = 0.0, weights=(0.
     return SchedulingProblem(flights=expanded, conflicts=c, weights=tuple(float(w) for w in weights),
                              aircraft_count=base.n_aircraft, objective_kind=objective, time_step_s=time_step_s,
                              core_families=core, extra_families=tuple(families_of(expanded)), objective_terms=terms)
-
-
-def _table(rows):
-    from uamopt.schedule.families.pairs import compress_rows
-
-    return compress_rows(sorted(rows))
 
 
 def speed_choice_of(problem) -> SpeedChoice | None:
