@@ -113,10 +113,18 @@ def cluster(tmp_path_factory) -> str:
     procs = [subprocess.Popen([str(dask), "scheduler", "--host", "127.0.0.1", "--port", "0", "--no-dashboard",
                                "--scheduler-file", str(scheduler_file)], **quiet)]
     try:
+        # The scheduler creates the file before it finishes writing it: wait for whole JSON, not for
+        # the file (an empty read made 17 tests error on a loaded CI machine).
         deadline = time.monotonic() + 60
-        while not scheduler_file.exists() and time.monotonic() < deadline:
-            time.sleep(0.1)
-        address = json.loads(scheduler_file.read_text())["address"]
+        address = None
+        while address is None:
+            try:
+                address = json.loads(scheduler_file.read_text())["address"]
+            except (OSError, ValueError, KeyError):
+                if time.monotonic() > deadline or procs[0].poll() is not None:
+                    raise RuntimeError(f"dask scheduler wrote no usable {scheduler_file} "
+                                       f"(exit code {procs[0].poll()})") from None
+                time.sleep(0.1)
         for _ in range(2):
             procs.append(subprocess.Popen([str(dask), "worker", address, "--nthreads", "1", "--no-dashboard",
                                            "--host", "127.0.0.1"], **quiet))
