@@ -101,6 +101,9 @@ class AircraftConfig(_Section):
     )
     cruise_speed_mps: Annotated[float, BeforeValidator(_number), Field(ge=0.1, le=200.0, allow_inf_nan=False)] = Field(
         25.0, description="v_g, m/s (Eq. 23); 0.1-200 m/s, the ground speeds `uamopt verify` accepts")
+    vertical_rate_mps: Annotated[float, BeforeValidator(_number), Field(gt=0, le=50.0, allow_inf_nan=False)] = Field(
+        2.5, description="climb and descent rate of the vertical take-off and landing, m/s (network.vertical_phases; "
+        "the paper gives none: 2.5 m/s ≈ 500 ft/min, docs/variants.md)")
     h_min: NonNegFloat = Field(90.0, description="h_min, aircraft minimum altitude, m (Eq. 14)")
     h_max: PositiveFloat = Field(3000.0, description="h_max, aircraft maximum altitude, m (Eq. 14)")
     range_m: PositiveFloat = Field(30000.0, description="L_e, m (Eq. 17)")
@@ -145,6 +148,8 @@ class Vertiport(_Section):
     name: Annotated[str, Field(min_length=1)]
     x: Real = Field(description="m, local frame")
     y: Real = Field(description="m, local frame")
+    pads: Annotated[int, Field(ge=1, le=1000, strict=True)] | None = Field(
+        None, description="FATO pads of this vertiport (family pads, docs/variants.md); omitted: network.pads")
 
 
 def _paper_vertiports() -> tuple[Vertiport, ...]:
@@ -199,6 +204,20 @@ class NetworkConfig(_Section):
         "lines between vertiports, a->b at the cruise altitude and b->a r + 1 layers up (scheduler benchmarks); "
         "'straight' also accepts --network / --flights tracks through buildings (uamopt/schedule/airspace.py)"
     )
+    vertical_phases: bool = Field(
+        False, description="flights take off vertically from the ground at their vertiport to the cruise altitude and "
+        "land vertically, at aircraft.vertical_rate_mps; those cells enter the occupancy and the conflicts "
+        "(the vertiport variant, docs/variants.md); false: the cruise only, the paper's model")
+    pads: Annotated[int, Field(ge=1, le=1000, strict=True)] | None = Field(
+        None, description="FATO pads per vertiport (a vertiport's own pads overrides): at most this many aircraft on "
+        "its pads at once, taking off, landing, or turning around (T_D/T_R) after landing (family pads, "
+        "docs/variants.md); omitted: unlimited, the paper's model")
+
+    def pads_of(self) -> dict[str, int] | None:
+        """Pads per vertiport name (a vertiport's own ``pads``, else ``pads``); None when no vertiport
+        has a limit (the paper's model). A vertiport without either has unlimited pads, left out."""
+        out = {v.name: v.pads if v.pads is not None else self.pads for v in self.vertiports}
+        return {k: int(v) for k, v in out.items() if v is not None} or None
 
     def route_list(self) -> list[tuple[str, str]]:
         """The routes (a, b): ``routes`` as given, or every pair of vertiports in their order

@@ -13,11 +13,14 @@ so solvers need no parity logic.
     {"cell": [dx, dy, dz], "conflict_radius": r,
      "service_start_s": 0, "service_end_s": 3600, "outbound_gap_s": 240, "return_gap_s": 360,
      "flights": [{"id", "aircraft", "route", "origin", "destination", "speed_mps",
-                  "planned_departure_s", "max_delay_s", "waypoints": [[x, y, z], ...]}]}
+                  "planned_departure_s", "max_delay_s", "waypoints": [[x, y, z], ...],
+                  "vertical_rate_mps" (optional)}]}
 
 The four service/gap keys are optional (defaults: 0, 3600 s, the scenario's T_D and T_R) and
 ``max_delay_s`` may be omitted (Eq. 29 with equality). A flight with ``waypoints`` is
-self-contained; one without must name a route of the given ``network``.
+self-contained; one without must name a route of the given ``network``. ``vertical_rate_mps``
+(the vertiport variant): the first segment is a vertical take-off and the last a vertical landing,
+both flown at that rate; the rest at ``speed_mps``.
 """
 
 from __future__ import annotations
@@ -42,6 +45,7 @@ if TYPE_CHECKING:
 DEFAULT_SERVICE_S = 3600.0  # T_f − T_s, s: one hour reproduces F = 6 per aircraft (Eq. 23, Table B.3)
 TIME_TOL_S = 1e-6  # slack for float round-off in time comparisons, s
 MAX_CONFLICT_RADIUS = 10  # r of a flights file: a zone of at most 21³ cells (schedule.conflict_radius's range)
+MAX_VERTICAL_RATE_MPS = 50.0  # climb/descent rate a flights file may claim, m/s (the verifier's range)
 
 
 def _frozen(array: np.ndarray) -> np.ndarray:
@@ -58,6 +62,36 @@ def round_half_up(value: float) -> float:
 def track_length_m(waypoints: np.ndarray) -> float:
     """Length of a piecewise-linear track (Eq. 31 times v_g), m."""
     return float(np.sum(np.linalg.norm(np.diff(np.asarray(waypoints, float), axis=0), axis=1)))
+
+
+def waypoint_times_s(waypoints: np.ndarray, speed_mps: float, vertical_rate_mps: float | None = None) -> np.ndarray:
+    """Time of each waypoint from departure, s: every segment flown at ``speed_mps`` (Eq. 31), except,
+    with ``vertical_rate_mps``, the first (vertical take-off) and last (vertical landing) segments,
+    flown at that climb/descent rate (the vertiport variant, docs/variants.md).
+
+    >>> waypoint_times_s(np.array([[0.0, 0, 0], [0, 0, 100], [250, 0, 100], [250, 0, 0]]), 25.0, 2.5).tolist()
+    [0.0, 40.0, 50.0, 90.0]
+    """
+    seg = np.linalg.norm(np.diff(np.asarray(waypoints, float), axis=0), axis=1)
+    rate = np.full(len(seg), float(speed_mps))
+    if vertical_rate_mps is not None:
+        rate[[0, -1]] = vertical_rate_mps
+    return np.concatenate([[0.0], np.cumsum(seg / rate)])
+
+
+def with_vertical_phases(waypoints: np.ndarray, ground_z_m: float = 0.0) -> np.ndarray:
+    """A cruise track with a vertical take-off from the ground below its first point and a vertical
+    landing to the ground below its last (the vertiport variant).
+
+    >>> with_vertical_phases(np.array([[0.0, 0, 120], [250, 0, 120]])).tolist()
+    [[0.0, 0.0, 0.0], [0.0, 0.0, 120.0], [250.0, 0.0, 120.0], [250.0, 0.0, 0.0]]
+    """
+    wp = np.asarray(waypoints, dtype=float)
+    first, last = wp[0].copy(), wp[-1].copy()
+    first[2] = last[2] = ground_z_m
+    out = np.vstack([first, wp, last])
+    out.setflags(write=False)
+    return out
 
 
 @dataclass(frozen=True, eq=False)
@@ -91,6 +125,9 @@ class Flight:
     max_delay_s: float
     waypoints: np.ndarray
     turnaround_after_s: float | None = None
+    #: climb/descent rate of the vertical take-off (first segment) and landing (last segment), m/s;
+    #: None: the track is the cruise only, flown at v_g throughout (the paper's model)
+    vertical_rate_mps: float | None = None
 
     @property
     def length_m(self) -> float:
@@ -98,8 +135,25 @@ class Flight:
 
     @property
     def flight_time_s(self) -> float:
-        """T_n of the last waypoint (Eq. 31): track length / v_g, s."""
-        return self.length_m / self.speed_mps
+        """T_n of the last waypoint (Eq. 31): track length / v_g, s (with vertical phases, those at
+        their rate: :func:`waypoint_times_s`)."""
+        if self.vertical_rate_mps is None:
+            return self.length_m / self.speed_mps
+        return float(waypoint_times_s(self.waypoints, self.speed_mps, self.vertical_rate_mps)[-1])
+
+    @property
+    def takeoff_s(self) -> float:
+        """Duration of the vertical take-off, s (0 without vertical phases)."""
+        if self.vertical_rate_mps is None:
+            return 0.0
+        return float(np.linalg.norm(self.waypoints[1] - self.waypoints[0])) / self.vertical_rate_mps
+
+    @property
+    def landing_s(self) -> float:
+        """Duration of the vertical landing, s (0 without vertical phases)."""
+        if self.vertical_rate_mps is None:
+            return 0.0
+        return float(np.linalg.norm(self.waypoints[-1] - self.waypoints[-2])) / self.vertical_rate_mps
 
     @property
     def planned_arrival_s(self) -> float:
@@ -283,14 +337,29 @@ def flight_from_dict(raw: Any, where: str, network: Mapping[str, np.ndarray] | N
         raise InputFileError(f"unknown route '{raw['route']}'", where, f"give 'waypoints' or one of the routes: {known}")
     if track_length_m(wp) <= 0:
         raise InputFileError("the track has zero length", where, "give an origin and a destination that differ")
+    rate = raw.get("vertical_rate_mps")
+    if rate is not None:
+        if isinstance(rate, bool) or not isinstance(rate, (int, float)) or not 0 < rate <= MAX_VERTICAL_RATE_MPS:
+            raise InputFileError(f"'vertical_rate_mps' must be a number in (0, {MAX_VERTICAL_RATE_MPS:g}] m/s, got {rate!r}",
+                                 where, "give the climb/descent rate of the vertical phases, or omit the key")
+        if len(wp) < 4 or not _vertical(wp[0], wp[1], up=True) or not _vertical(wp[-2], wp[-1], up=False):
+            raise InputFileError("'vertical_rate_mps' needs a vertical climb as the first segment and a vertical "
+                                 "descent as the last (at least 4 waypoints)", where,
+                                 "write the take-off and landing as vertical segments, or omit vertical_rate_mps")
+        rate = float(rate)
     wp.setflags(write=False)
     max_delay = raw.get("max_delay_s")
     return Flight(
         id=str(raw["id"]), aircraft=str(raw["aircraft"]), route=str(raw["route"]), origin=str(raw["origin"]),
         destination=str(raw["destination"]), speed_mps=float(raw["speed_mps"]),
         planned_departure_s=float(raw["planned_departure_s"]),
-        max_delay_s=float("nan") if max_delay is None else float(max_delay), waypoints=wp,
+        max_delay_s=float("nan") if max_delay is None else float(max_delay), waypoints=wp, vertical_rate_mps=rate,
     )
+
+
+def _vertical(a: np.ndarray, b: np.ndarray, up: bool) -> bool:
+    """Segment a→b is vertical (same x, y within 1e-6 m) and climbs (``up``) or descends."""
+    return bool(np.all(np.abs(b[:2] - a[:2]) <= 1e-6) and ((b[2] > a[2]) if up else (b[2] < a[2])))
 
 
 def check_flightset(flightset: FlightSet, grid: AirspaceGrid | None = None, source: str = "flights.json") -> None:
@@ -447,6 +516,7 @@ def flightset_to_dict(flightset: FlightSet) -> dict:
                 "destination": f.destination, "speed_mps": f.speed_mps,
                 "planned_departure_s": f.planned_departure_s, "max_delay_s": f.max_delay_s,
                 "waypoints": f.waypoints.tolist(),
+                **({} if f.vertical_rate_mps is None else {"vertical_rate_mps": f.vertical_rate_mps}),
             }
             for f in flightset.flights
         ],

@@ -132,7 +132,8 @@ class SchedulingProblem:
         """The conflicting pairs: forbidden intervals, reach and admissible gaps of δ (core.py)."""
         from uamopt.schedule.families.pairs import merged
 
-        p, q, ptr, intervals = merged(self.of_shape("pairs"))
+        # a cumulative family's one-pad resources are pairs too (families/pads.py)
+        p, q, ptr, intervals = merged(self.of_shape("pairs") + [f.disjunctive() for f in self.of_shape("cumulative")])
         return pair_view(p, q, ptr, intervals, self.planned_departure_s, self.delay_upper_s)
 
     @property

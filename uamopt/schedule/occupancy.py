@@ -46,7 +46,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from uamopt.schedule.flights import TIME_TOL_S, FlightSet
+from uamopt.schedule.flights import TIME_TOL_S, FlightSet, waypoint_times_s
 
 MERGE_TOL_S = 1e-9  # breakpoints closer than this are one instant, s
 OFFSET_LIMIT = 1e8  # largest float offset used to separate groups in one vectorised pass, s
@@ -77,8 +77,10 @@ class PairConflict:
     intervals: np.ndarray
 
 
-def track_occupancy(waypoints: np.ndarray, speed_mps: float, cell: tuple[float, float, float]) -> Occupancy:
-    """Entry and exit time of every cell a track passes through, flown at ``speed_mps`` from t = 0.
+def track_occupancy(waypoints: np.ndarray, speed_mps: float, cell: tuple[float, float, float],
+                    vertical_rate_mps: float | None = None) -> Occupancy:
+    """Entry and exit time of every cell a track passes through, flown at ``speed_mps`` from t = 0
+    (with ``vertical_rate_mps``: its first and last segments at that rate, ``waypoint_times_s``).
 
     Parameters
     ----------
@@ -98,10 +100,9 @@ def track_occupancy(waypoints: np.ndarray, speed_mps: float, cell: tuple[float, 
     pts = np.asarray(waypoints, dtype=float)
     keep = np.ones(len(pts), dtype=bool)
     keep[1:] = np.any(np.diff(pts, axis=0) != 0, axis=1)
-    pts = pts[keep]
+    t_all = waypoint_times_s(pts, speed_mps, vertical_rate_mps)  # Eq. 31
+    pts, t_vertex = pts[keep], t_all[keep]
     size = np.asarray(cell, dtype=float)
-    seg_len = np.linalg.norm(np.diff(pts, axis=0), axis=1)
-    t_vertex = np.concatenate([[0.0], np.cumsum(seg_len)]) / speed_mps  # Eq. 31
     p0, p1 = pts[:-1], pts[1:]
     t0, dt = t_vertex[:-1], np.diff(t_vertex)
     times = [t_vertex]
@@ -140,10 +141,10 @@ def flight_occupancies(flightset: FlightSet) -> tuple[list[Occupancy], np.ndarra
     occupancies: list[Occupancy] = []
     key = np.empty(len(flightset), dtype=np.int64)
     for i, f in enumerate(flightset.flights):
-        k = (np.ascontiguousarray(f.waypoints, dtype=float).tobytes(), float(f.speed_mps))
+        k = (np.ascontiguousarray(f.waypoints, dtype=float).tobytes(), float(f.speed_mps), f.vertical_rate_mps)
         if k not in index:
             index[k] = len(occupancies)
-            occupancies.append(track_occupancy(f.waypoints, f.speed_mps, flightset.cell))
+            occupancies.append(track_occupancy(f.waypoints, f.speed_mps, flightset.cell, f.vertical_rate_mps))
         key[i] = index[k]
     return occupancies, key
 

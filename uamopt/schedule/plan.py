@@ -20,7 +20,8 @@ from uamopt.schedule.flights import (
     FlightSet,
     check_flightset,
     round_half_up,
-    track_length_m,
+    waypoint_times_s,
+    with_vertical_phases,
 )
 
 if TYPE_CHECKING:
@@ -186,12 +187,15 @@ def generate_plan(
                           "Eq. 29 bounds Δd by round(L/v_g) + ΔT; give a fraction of that bound")
     speed = scenario.aircraft.cruise_speed_mps
     routes = scenario_routes(scenario)
+    rate = scenario.aircraft.vertical_rate_mps if scenario.network.vertical_phases else None
+    if rate is not None:  # the vertiport variant: take-off from and landing to the ground (z = 0) below P_O, P_D
+        network = {name: with_vertical_phases(wp) for name, wp in network.items()}
     for a, b in routes:
         for name in (route_name(a, b), route_name(b, a)):
             if name not in network:
                 raise UamoptError(f"unknown route '{name}'", "network", f"give tracks for every route; known: {', '.join(network)}")
     if total is None:
-        longest = max(track_length_m(t) for t in network.values())
+        longest = speed * max(waypoint_times_s(t, speed, rate)[-1] for t in network.values())  # L_g/v_g: the longest flight time
         per_aircraft = [flights_per_aircraft(service_s, longest, speed, sched.outbound_gap_s, sched.return_gap_s,
                                              sched.interference)] * n_aircraft
         if per_aircraft[0] < 1:
@@ -208,7 +212,7 @@ def generate_plan(
         n_flights = per_aircraft[g]
         a, b = routes[g % len(routes)]
         legs = [(a, b) if f % 2 == 0 else (b, a) for f in range(n_flights)]
-        times = [track_length_m(network[route_name(o, d)]) / speed for o, d in legs]
+        times = [float(waypoint_times_s(network[route_name(o, d)], speed, rate)[-1]) for o, d in legs]
         gaps = [sched.outbound_gap_s if f % 2 == 0 else sched.return_gap_s for f in range(n_flights)]  # f is 0-based here
         slack = service_s - (sum(times) + sum(gaps[:-1]))
         if slack < -1e-9:
@@ -227,7 +231,7 @@ def generate_plan(
             plan.append(Flight(
                 id=f"F{len(plan) + 1:03d}", aircraft=aircraft_id, route=route_name(o, d), origin=o, destination=d,
                 speed_mps=speed, planned_departure_s=departure, max_delay_s=round_half_up(scale * (round_half_up(t) + gap)),
-                waypoints=network[route_name(o, d)], turnaround_after_s=gap,
+                waypoints=network[route_name(o, d)], turnaround_after_s=gap, vertical_rate_mps=rate,
             ))
             departure = departure + t + gap
     notes = ()

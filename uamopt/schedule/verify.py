@@ -12,18 +12,26 @@ the float round-off of that magnitude, ``close_s``):
 
 - each flight of flights.json appears once in schedule.csv with the same aircraft, route and
   planned departure; departure = planned + delay; arrival = departure + length / speed (Eq. 31);
+  a flight with ``vertical_rate_mps`` r (the vertiport variant: take-off and landing phases) has a
+  vertical climbing first and descending last segment, flown at r, and arrival = departure +
+  climb_s + cruise_s + descent_s (climb_s = (z1 − z0) / r, descent_s = (z[-2] − z[-1]) / r,
+  cruise_s = the middle segments' length / speed);
 - 0 ≤ delay ≤ max_delay_s (Eq. 29), service start ≤ planned departure and departure (Eq. 23),
   arrival ≤ service end (Eq. 26); turnaround gaps are never negative;
 - a return (even leg of its aircraft) is not operated without its outbound;
 - an operated flight departs ≥ the previous operated flight's arrival + ΔT (Eqs. 27-28:
   T_D after an odd leg, T_R after an even leg);
 - no two operated flights of different aircraft occupy cells within ``conflict_radius`` in every
-  axis during overlapping times of more than ``TOL_S`` (touching is not a conflict);
+  axis during overlapping times of more than ``TOL_S`` (touching is not a conflict); the vertical
+  phases count like any other segment, timed at the vertical rate;
+- the extra families summary.json lists (``pads``, ``departure_spacing``, ...:
+  uamopt/schedule/verify_variants.py);
 - summary.json's counts, delays and (when its weights are given) objective agree.
 
 The folder is untrusted input: a field out of its range (a negative or non-integer conflict
 radius, a cell that is not positive, waypoints that are not finite or lie outside the local
-frame, a speed outside 0.1–200 m/s, times beyond 10⁷ s, a flight id twice, a conflict search
+frame, a speed outside 0.1–200 m/s, a ``vertical_rate_mps`` outside (0, 50] m/s or without a
+vertical first and last segment, times beyond 10⁷ s, a flight id twice, a conflict search
 beyond ``MAX_VISITS`` cells (millimetre cells), a summary that is not an object or whose weights
 are not two numbers, text that is not UTF-8) is an ``InputFileError`` (exit 2), never a pass; a
 waypoint outside the grid ``extent_m`` that summary.json records is a violation (exit 1).
@@ -52,6 +60,8 @@ MAX_RADIUS = 10  # conflict zone of at most 21³ cells
 SPEED_RANGE_MPS = (0.1, 200.0)  # ground speeds a flight file may claim, m/s
 MAX_TIME_S = 1e7  # |planned departure| and delay bounds, s (about 116 days)
 MAX_COORD_M = 1e6  # waypoint coordinates of the local frame, m (1,000 km)
+VERTICAL_RATE_MPS = 50.0  # largest vertical_rate_mps a flight file may claim (exclusive lower bound 0), m/s
+VERTICAL_XY_M = 1e-6  # a vertical segment's waypoints share x and y within this, m
 MAX_VISITS = 10_000_000  # cell visits and time buckets the conflict search may hold (about 1 GB)
 ULP = 1e-14  # float round-off per unit of magnitude allowed on top of TOL_S (1e-7 s at 10⁷ s)
 
@@ -73,20 +83,27 @@ def _next_crossing(p0, d, dur: float, idx: list[int], step: list[int], cell, a: 
     return (plane - p0[a]) / d[a] * dur
 
 
-def cell_visits(waypoints, speed_mps: float, cell) -> list[tuple[tuple[int, int, int], float, float]]:
-    """(cell, t_in, t_out) of every cell a track passes through at constant speed from t = 0.
+def cell_visits(waypoints, speed_mps: float, cell,
+                segment_speeds=None) -> list[tuple[tuple[int, int, int], float, float]]:
+    """(cell, t_in, t_out) of every cell a track passes through from t = 0, at ``speed_mps`` or,
+    when ``segment_speeds`` is given (one speed per segment, m/s), segment i at segment_speeds[i]
+    (the vertiport variant: climb and descent at the vertical rate).
 
     Walks each segment cell by cell: per axis, the time of the next plane crossing; step the
     axis (or axes, on a tie) that crosses first.
     """
+    n_segments = max(0, len(waypoints) - 1)
+    speeds = [speed_mps] * n_segments if segment_speeds is None else list(segment_speeds)
+    if len(speeds) != n_segments:
+        raise ValueError(f"segment_speeds has {len(speeds)} speeds for {n_segments} segments")
     raw: list[tuple[tuple[int, int, int], float, float]] = []
     t = 0.0
-    for p0, p1 in itertools.pairwise(waypoints):
+    for (p0, p1), speed in zip(itertools.pairwise(waypoints), speeds):
         d = [p1[a] - p0[a] for a in range(3)]
         length = math.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
         if length == 0.0:
             continue
-        dur = length / speed_mps
+        dur = length / speed
         idx, step = [0, 0, 0], [0, 0, 0]
         for a in range(3):
             s = p0[a] / cell[a]
@@ -192,9 +209,43 @@ def _read_flights(path: Path) -> dict:
             raise InputFileError(f"flight id {rec['id']!r} appears twice", where, "give every flight its own id")
         seen.add(rec["id"])
         rec["length"] = sum(math.dist(a, b) for a, b in itertools.pairwise(wps))
+        rec["origin"] = None if f.get("origin") is None else str(f["origin"])
+        rec["destination"] = None if f.get("destination") is None else str(f["destination"])
+        _phases(rec, f.get("vertical_rate_mps"), where)
         out["flights"].append(rec)
     _check_work(out, str(path))
     return out
+
+
+def _phases(rec: dict, rate, where: str) -> None:
+    """Add the flight's phases to ``rec``: ``climb_s``, ``cruise_s``, ``descent_s``, ``duration``
+    (s), ``cruise_length`` (m) and ``segment_speeds`` (m/s, one per segment). Without a vertical
+    rate the whole track is cruise at ``speed_mps`` (duration = length / speed, as in Eq. 31)."""
+    wps, n = rec["waypoints"], len(rec["waypoints"]) - 1
+    if rate is None:
+        rec.update(rate=None, climb_s=0.0, descent_s=0.0, cruise_length=rec["length"],
+                   cruise_s=rec["length"] / rec["speed"], duration=rec["length"] / rec["speed"],
+                   segment_speeds=[rec["speed"]] * n)
+        return
+    if isinstance(rate, bool) or not isinstance(rate, (int, float)) or not math.isfinite(rate) \
+            or not 0 < rate <= VERTICAL_RATE_MPS:
+        raise InputFileError(f"flight {rec['id']}: vertical_rate_mps must be a number in (0, {VERTICAL_RATE_MPS:g}] m/s, got {rate!r}", where,
+                             "rewrite the file with uamopt schedule")
+    rate = float(rate)
+
+    def vertical(a, b) -> bool:
+        return abs(a[0] - b[0]) <= VERTICAL_XY_M and abs(a[1] - b[1]) <= VERTICAL_XY_M
+
+    if len(wps) < 4 or not (vertical(wps[0], wps[1]) and wps[1][2] > wps[0][2]
+                            and vertical(wps[-2], wps[-1]) and wps[-2][2] > wps[-1][2]):
+        raise InputFileError(f"flight {rec['id']}: vertical_rate_mps needs a vertical first and last segment: at least 4 waypoints, "
+                             "ground -> top of climb (same x, y, higher z) ... top of descent -> ground (same x, y, "
+                             f"lower z), got {len(wps)} waypoints", where, "rewrite the file with uamopt schedule")
+    cruise_length = sum(math.dist(a, b) for a, b in itertools.pairwise(wps[1:-1]))
+    climb_s, descent_s = (wps[1][2] - wps[0][2]) / rate, (wps[-2][2] - wps[-1][2]) / rate
+    cruise_s = cruise_length / rec["speed"]
+    rec.update(rate=rate, climb_s=climb_s, descent_s=descent_s, cruise_length=cruise_length, cruise_s=cruise_s,
+               duration=climb_s + cruise_s + descent_s, segment_speeds=[rate] + [rec["speed"]] * (n - 2) + [rate])
 
 
 def _check_work(spec: dict, where: str) -> None:
@@ -204,7 +255,7 @@ def _check_work(spec: dict, where: str) -> None:
     for f in spec["flights"]:
         for a, b in itertools.pairwise(f["waypoints"]):
             work += 1 + sum(abs(b[k] - a[k]) / cell[k] for k in range(3))
-        work += f["length"] / f["speed"] / BUCKET_S
+        work += f["duration"] / BUCKET_S
     if work > MAX_VISITS:
         raise InputFileError(f"the conflict search would visit about {work:.3g} cells and time buckets "
                              f"(cell {', '.join(f'{c:g}' for c in cell)} m), more than {MAX_VISITS:.0e}", where,
@@ -263,9 +314,9 @@ def _conflicts(flights: list[dict], cell, radius: int) -> list[str]:
     cache: dict = {}
     table: dict[tuple, list] = defaultdict(list)
     for n, f in enumerate(flights):
-        key = (tuple(f["waypoints"]), f["speed"])
+        key = (tuple(f["waypoints"]), tuple(f["segment_speeds"]))
         if key not in cache:
-            cache[key] = cell_visits(f["waypoints"], f["speed"], cell)
+            cache[key] = cell_visits(f["waypoints"], f["speed"], cell, f["segment_speeds"])
         for c, a, b in cache[key]:
             a, b = f["departure"] + a, f["departure"] + b
             home = (c[0] // block, c[1] // block, c[2] // block)
@@ -340,9 +391,12 @@ def verify_files(flights_path: Path, schedule_path: Path, summary_path: Path | N
                        f"{spec['service_start_s']:g} s (Eq. 23)")
         if not close_s(f["departure"], f["planned"] + d):
             out.append(f"flight {f['id']}: departure {f['departure']} s ≠ planned {f['planned']} + delay {d} s")
-        if not close_s(f["arrival"], f["departure"] + f["length"] / f["speed"]):
+        if f["rate"] is None and not close_s(f["arrival"], f["departure"] + f["duration"]):
             out.append(f"flight {f['id']}: arrival {f['arrival']} s ≠ departure + track length / speed "
-                       f"= {f['departure'] + f['length'] / f['speed']:.6f} s")
+                       f"= {f['departure'] + f['duration']:.6f} s")
+        elif f["rate"] is not None and not close_s(f["arrival"], f["departure"] + f["duration"]):
+            out.append(f"flight {f['id']}: arrival {f['arrival']} s ≠ departure + climb {f['climb_s']:.6f} s + cruise "
+                       f"{f['cruise_s']:.6f} s + descent {f['descent_s']:.6f} s = {f['departure'] + f['duration']:.6f} s")
         if f["arrival"] > spec["service_end_s"] + TOL_S:
             out.append(f"flight {f['id']}: arrives at {f['arrival']:.3f} s, after the service end {spec['service_end_s']:g} s (Eq. 26)")
         flown.append(f)
@@ -351,6 +405,7 @@ def verify_files(flights_path: Path, schedule_path: Path, summary_path: Path | N
         chain = sorted(chain, key=lambda f: f["planned"])  # stable: file order on ties
         last = None
         for leg, f in enumerate(chain, start=1):
+            f["gap_after_s"] = t_out if leg % 2 == 1 else t_back  # its turnaround ΔT (Eqs. 27-28; pads)
             if leg % 2 == 0 and f["operated"] and not chain[leg - 2]["operated"]:
                 out.append(f"flight {f['id']}: return operated without its outbound {chain[leg - 2]['id']}")
             if not f["operated"]:

@@ -42,7 +42,7 @@ def check_summary(path: Path, spec: dict, flown: list[dict], n_aircraft: int) ->
         if summary.get("objective_kind", "weighted") == "weighted":
             expect["objective"] = w6 * total / n_aircraft - w7 * len(flown)
         else:
-            upper = sum(max(0.0, min(f["max_delay"], spec["service_end_s"] - f["planned"] - f["length"] / f["speed"]))
+            upper = sum(max(0.0, min(f["max_delay"], spec["service_end_s"] - f["planned"] - f["duration"]))
                         for f in spec["flights"])
             expect["objective"] = -len(flown) + total / (upper + 1.0)
     for key, value in expect.items():

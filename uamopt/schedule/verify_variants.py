@@ -16,6 +16,14 @@ the verifier does not know is a violation ("cannot be checked"), never a pass.
   recomputed (lexicographic: the delay weight over every speed of every flight).
 - ``departure_spacing`` with ``spacing_s``: operated flights that start at one point (the first
   waypoint of flights.json: one vertiport) depart at least ``spacing_s`` apart.
+- ``pads`` (shape ``cumulative``) with ``pads`` {vertiport: capacity, an integer ≥ 1}: an operated
+  flight holds one pad of its ``origin`` (flights.json) during [departure, departure + climb_s)
+  and one of its ``destination`` during [arrival − descent_s, arrival + ΔT), ΔT its turnaround gap
+  (outbound_gap_s after an odd leg of its aircraft, return_gap_s after an even leg); climb_s and
+  descent_s are 0 without ``vertical_rate_mps`` (verify.py). Intervals are half-open and may
+  overlap by ``TOL_S``; at no instant may a vertiport hold more pads than its capacity (one
+  violation per period over capacity). A vertiport a flight names but the record omits, or a
+  flight without an origin or destination name, is a violation (it cannot be checked).
 """
 
 from __future__ import annotations
@@ -24,6 +32,7 @@ import hashlib
 from pathlib import Path
 
 from uamopt.errors import InputFileError
+from uamopt.schedule.verify_summary import TOL_S
 
 TOL = 1e-6  # on landing times and the objective (relative above 1)
 
@@ -98,6 +107,66 @@ def _check_spacing(record: dict, flown: list[dict], where: str) -> list[str]:
     return out
 
 
+def _slack_s(t: float) -> float:
+    """The overlap two pad holds may share at time ``t``: ``TOL_S`` plus the float round-off of
+    that magnitude (as verify.close_s: absolute at any magnitude of time)."""
+    return TOL_S + 1e-14 * abs(t)
+
+
+def _check_pads(record: dict, flown: list[dict], where: str) -> list[str]:
+    """Pads held at each vertiport never exceed its capacity (module docstring): a sweep over the
+    holds' start and end times, ends first on a tie (half-open), each end moved ``_slack_s``
+    earlier so that holds overlapping by at most ``TOL_S`` do not count together."""
+    pads = record.get("pads")
+    if not isinstance(pads, dict) or not all(
+            isinstance(c, int) and not isinstance(c, bool) and c >= 1 for c in pads.values()):
+        raise InputFileError(f"pads: 'pads' must be an object of vertiport name -> capacity (an integer ≥ 1), got {pads!r}",
+                             where, "rewrite it with uamopt schedule")
+    out: list[str] = []
+    holds: dict[str, list[tuple[float, float, str]]] = {}
+    unnamed: list[str] = []
+    for f in flown:
+        if f.get("origin") is None or f.get("destination") is None:
+            unnamed.append(f["id"])
+            continue
+        take_off = (f["departure"], f["departure"] + f["climb_s"])
+        landing = (f["arrival"] - f["descent_s"], f["arrival"] + f["gap_after_s"])
+        for port, (a, b) in ((f["origin"], take_off), (f["destination"], landing)):
+            holds.setdefault(port, [])
+            if b > a:
+                holds[port].append((a, b, f["id"]))
+    if unnamed:
+        out.append(f"pads: flights {', '.join(unnamed)} have no origin or destination vertiport in flights.json, "
+                   "their pads cannot be checked")
+    for port in sorted(holds):
+        if port not in pads:
+            users = sorted({fid for _, _, fid in holds[port]})
+            out.append(f"pads: vertiport {port} has no pad capacity in the pads record"
+                       + (f" (flights {', '.join(users)} hold a pad there)" if users else ""))
+            continue
+        cap = pads[port]
+        events = []  # (time, 0 = end / 1 = start, hold number)
+        for n, (a, b, _) in enumerate(holds[port]):
+            events.append((a, 1, n))
+            events.append((b - _slack_s(b), 0, n))
+        events.sort()
+        active: set[int] = set()
+        breach = None  # (start time, peak count, flights involved)
+        for t, kind, n in events:
+            if kind == 0:
+                active.discard(n)
+                if breach is not None and len(active) <= cap:
+                    out.append(f"pads: vertiport {port} holds {breach[1]} pads at {breach[0]:.3f} s, more than its "
+                               f"capacity {cap} (flights {', '.join(sorted(breach[2]))})")
+                    breach = None
+                continue
+            active.add(n)
+            if len(active) > cap:
+                ids = {holds[port][m][2] for m in active}
+                breach = (t, len(active), ids) if breach is None else (breach[0], max(breach[1], len(active)), breach[2] | ids)
+    return out
+
+
 def _check_speeds(record: dict, summary: dict, spec: dict, flown: list[dict], where: str) -> list[str]:
     """Each operated flight's speed (flights.json) is an allowed factor of its cruise speed, and the
     objective with the change costs (weights, or the lexicographic weight over every speed copy)."""
@@ -130,7 +199,8 @@ def _check_speeds(record: dict, summary: dict, spec: dict, flown: list[dict], wh
         for f in spec["flights"]:
             v = cruise.get(f["id"], f["speed"])
             for k in factors:
-                upper += max(0.0, min(f["max_delay"], spec["service_end_s"] - f["planned"] - f["length"] / (k * v)))
+                duration = f["climb_s"] + f["cruise_length"] / (k * v) + f["descent_s"]  # length / (k v) without phases
+                upper += max(0.0, min(f["max_delay"], spec["service_end_s"] - f["planned"] - duration))
                 upper += float(cost) if k != 1.0 else 0.0
         expect = -len(flown) + total / (upper + 1.0)
     got = summary["objective"]
@@ -155,6 +225,8 @@ def check_families(summary: dict, spec: dict, flown: list[dict], where: str) -> 
             objective_checked = True
         elif record.get("name") == "departure_spacing":
             out += _check_spacing(record, flown, where)
+        elif record.get("name") == "pads":
+            out += _check_pads(record, flown, where)
         elif record.get("name") == "speed_choice":
             out += _check_speeds(record, summary, spec, flown, where)
             objective_checked = True

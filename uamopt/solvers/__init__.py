@@ -115,7 +115,10 @@ def unsupported(module, problem: SchedulingProblem) -> str | None:
     solver that lists ``FAMILIES``, whose name) it lacks, or the objective kind; None if it can."""
     for family in problem.families:
         names = getattr(module, "FAMILIES", None)
-        if family.shape not in module.SHAPES or (names is not None and family.name not in names):
+        shape = family.shape
+        if shape == "cumulative" and len(family.residual().flight) == 0:
+            shape = "pairs"  # only one-pad resources: disjunctive, read through problem.pairs
+        if shape not in module.SHAPES or (names is not None and family.name not in names):
             return f"family '{family.name}'"
     if problem.objective.kind not in module.OBJECTIVES:
         return f"objective '{problem.objective.kind}'"

@@ -15,6 +15,8 @@ hand-made pairs) and enumerates instead of modelling:
    ``scipy.optimize.linprog`` (HiGHS). The gap choices are enumerated depth first; a partial
    choice is an LP relaxation of its completions, so a branch is cut when its LP is infeasible
    or already no better than the best completion found (exact pruning).
+   A ``cumulative`` family (vertiport pads with n > 1) branches the same way: for every n + 1
+   operated holds of one resource, one of them ends before another starts.
 3. c vectors are abandoned once −ω7·S (the objective with zero delay) cannot beat the best.
 
 Register nothing: call ``solve(problem, profile)`` (same signature as the solvers) from tests.
@@ -31,7 +33,7 @@ from scipy.optimize import linprog
 from uamopt.errors import UamoptError
 from uamopt.schedule.model import Schedule, SchedulingProblem, make_schedule
 
-SHAPES = frozenset({"bounds", "must_operate", "precedence", "turnaround", "pairs"})  # every shape, read from the problem
+SHAPES = frozenset({"bounds", "must_operate", "precedence", "turnaround", "pairs", "cumulative"})  # every shape
 OBJECTIVES = frozenset({"weighted", "lexicographic", "earliness_tardiness"})
 MAX_FLIGHTS = 10  # 2¹⁰ operate vectors; beyond that use ``highs``
 LP_TOL = 1e-7  # the LP's own accuracy on Σ d, s
@@ -70,6 +72,23 @@ def _lp(problem: SchedulingProblem, flown: list[int], rows: list[tuple[int, int,
     return (float(res.fun) if o.per_flight_terms else float(res.fun) * o.per_delay), d
 
 
+def _cumulative_choices(res, operated: np.ndarray, dep: np.ndarray) -> list:
+    """Capacity n at a resource ⇔ no n + 1 operated holds pairwise overlap (intervals: Helly), so for
+    every n + 1 of them one pair is disjoint, one before the other: a choice of linear rows
+    (a before b: dep_a + d_a + o_a + l_a ≤ dep_b + d_b + o_b)."""
+    out = []
+    for r in np.unique(res.resource).tolist():
+        ev = [k for k in np.flatnonzero(res.resource == r).tolist() if operated[res.flight[k]]]
+        for subset in itertools.combinations(ev, int(res.capacity[r]) + 1):
+            choice = []
+            for a, b in itertools.permutations(subset, 2):
+                fa, fb = int(res.flight[a]), int(res.flight[b])
+                bound = dep[fb] + res.offset_s[b] - dep[fa] - res.offset_s[a] - res.duration_s[a]
+                choice.append([(fa, fb, float(bound))])
+            out.append(choice)
+    return out
+
+
 def least_delay(problem: SchedulingProblem, operated: np.ndarray) -> tuple[float, np.ndarray] | None:
     """The least delay cost (per_delay · Σ d, or the earliness/tardiness sum) and its delays for the
     operate vector ``operated``, or None if none is feasible."""
@@ -91,6 +110,8 @@ def least_delay(problem: SchedulingProblem, operated: np.ndarray) -> tuple[float
         # δ ∈ [a, b]  ⇔  d_p − d_q ≤ ΔD − a  and  d_q − d_p ≤ b − ΔD
         shift = dep[q] - dep[p]
         branching.append([[(p, q, shift - a), (q, p, b - shift)] for a, b in gaps])
+    for family in problem.of_shape("cumulative"):
+        branching += _cumulative_choices(family.residual(), operated, dep)
     branching.sort(key=len)
     best: list = [np.inf, None]
     tol = LP_TOL * max(problem.objective.per_delay, 1e-300) if not problem.objective.per_flight_terms else LP_TOL

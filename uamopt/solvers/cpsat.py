@@ -164,9 +164,29 @@ def encode_pairs(v: _Vars, problem: SchedulingProblem, family=None) -> None:
             v.model.add_linear_expression_in_domain(delay[q] - delay[p], allowed).only_enforce_if([operate[p], operate[q]])
 
 
+def encode_cumulative(v: _Vars, problem: SchedulingProblem, family) -> None:
+    """AddCumulative per resource over the events of ``family.residual()`` (one-capacity
+    resources are pairs, encoded by :func:`encode_pairs`): optional fixed-size intervals present
+    iff their flight operates. ``outer`` covers each continuous hold by whole units
+    [⌊s/u⌋, ⌈e/u⌉) (feasible on the lattice ⇒ feasible); ``inner`` keeps only the units every
+    delay of the cell [k u, (k+1) u) covers, [⌈s/u⌉ + 1, ⌊e/u⌋) (a relaxation)."""
+    res, eta, u = family.residual(), v.eta, v.unit_s
+    start_s = problem.planned_departure_s[res.flight] + res.offset_s
+    for r in np.unique(res.resource).tolist():
+        intervals = []
+        for k in np.flatnonzero(res.resource == r).tolist():
+            f, a, b = int(res.flight[k]), start_s[k] / u, (start_s[k] + res.duration_s[k]) / u
+            lo, hi = ((math.floor(a + eta), math.ceil(b - eta)) if v.rounding == "outer"
+                      else (math.ceil(a - eta) + 1, math.floor(b + eta)))
+            if hi > lo:
+                intervals.append(v.model.new_optional_fixed_size_interval_var(
+                    v.delay[f] + lo, hi - lo, v.operate[f], f"pad{r}_{k}"))
+        v.model.add_cumulative(intervals, [1] * len(intervals), int(res.capacity[r]))
+
+
 #: one encoder per family shape (uamopt.schedule.families); pairs and turnaround: the merged views, once
 ENCODERS = {"bounds": encode_bounds, "must_operate": encode_must_operate, "precedence": encode_precedence,
-            "turnaround": encode_turnaround, "pairs": encode_pairs}
+            "turnaround": encode_turnaround, "pairs": encode_pairs, "cumulative": encode_cumulative}
 SHAPES = frozenset(ENCODERS)
 OBJECTIVES = frozenset({"weighted", "lexicographic", "earliness_tardiness"})
 
@@ -231,6 +251,10 @@ def lattice_is_exact(problem: SchedulingProblem, unit_s: float, how: str) -> boo
         times.append(problem.objective.target_s)
     if problem.objective.operate_cost_s is not None:
         times.append(problem.objective.operate_cost_s)
+    for family in problem.of_shape("cumulative"):  # the holds' ends, too
+        res = family.residual()
+        start = problem.planned_departure_s[res.flight] + res.offset_s
+        times += [start, start + res.duration_s]
     for values in times:
         units = np.asarray(values, dtype=float) / unit_s
         finite = units[np.isfinite(units)]

@@ -169,6 +169,8 @@ def build_model(problem: SchedulingProblem, extra=None) -> pyo.ConcreteModel:
     define_variables(m, problem)
     done = set()
     for family in problem.families:
+        if family.shape == "cumulative":  # one-pad resources only (check_supported): rows of problem.pairs
+            continue
         if family.shape in ("pairs", "turnaround"):  # merged views: encoded once
             if family.shape in done:
                 continue

@@ -15,6 +15,9 @@ A :class:`~uamopt.schedule.SchedulingProblem` carries its objective and a tuple 
   ``precedence``   f operated ⇒ requires[f] operated;
   ``bounds``       0 ≤ d_f ≤ upper_s[f] (Eqs. 26, 29; time windows);
   ``must_operate`` c_f = 1 where mask[f].
+  ``cumulative``   events (flight, resource, offset, duration): at most capacity[r] operated
+                   events hold resource r at once (vertiport pads); one-capacity resources are
+                   read as ``pairs`` (``problem.pairs``), so only the rest needs this shape.
 
   A new family of an existing shape needs no solver change (docs/variants.md). A solver that has
   no encoder for a family's shape refuses before it starts (:func:`uamopt.solvers.check_supported`).
@@ -41,7 +44,7 @@ if TYPE_CHECKING:
     from uamopt.schedule.flights import FlightSet
     from uamopt.schedule.model import SchedulingProblem
 
-SHAPES = ("pairs", "turnaround", "precedence", "bounds", "must_operate")
+SHAPES = ("pairs", "turnaround", "precedence", "bounds", "must_operate", "cumulative")
 
 
 @runtime_checkable

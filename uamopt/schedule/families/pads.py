@@ -1,0 +1,112 @@
+"""Family ``pads`` (shape ``cumulative``): at most n aircraft on a vertiport's pads (FATO) at once.
+
+The vertiport variant (docs/variants.md). An operated flight f holds one pad of its origin during
+its vertical take-off, [d_f, d_f + t_up), and one pad of its destination from the start of its
+vertical landing to the end of its turnaround, [a_f − t_down, a_f + ΔT_f) (T_D after an outbound,
+T_R after a return; Eq. 28). After the turnaround the aircraft leaves the pad for a stand, so a
+later departure takes a pad again for its take-off only (the reading of docs/variants.md).
+Intervals are half-open: a take-off may start the instant a turnaround ends. Without vertical
+phases t_up = t_down = 0 and only the landing's turnaround holds a pad.
+
+Every event is an offset and a duration from its flight's departure, so:
+
+- a vertiport with **one** pad is a disjunctive resource: two events there must not overlap,
+  δ = d_b − d_a ∉ (o_a − o_b − l_b, o_a + l_a − o_b), the ``pairs`` shape
+  (:meth:`Pads.disjunctive`, merged into ``problem.pairs``), which every solver encodes;
+- a vertiport with more pads is a cumulative resource (:meth:`Pads.residual`), encoded by the
+  solvers whose module lists the shape ``cumulative`` (cpsat's AddCumulative, the brute force);
+  the others refuse it in one line.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from uamopt.schedule.families.pairs import PairIntervals
+
+
+@dataclass(frozen=True, eq=False)
+class Pads:
+    """Event k: flight ``flight[k]`` holds a pad of vertiport ``resources[resource[k]]`` during
+    [d + offset_s[k], d + offset_s[k] + duration_s[k]); at most ``capacity[r]`` at once."""
+
+    resources: tuple[str, ...]
+    capacity: np.ndarray  # (R,) int
+    flight: np.ndarray  # (E,) int64
+    resource: np.ndarray  # (E,) int64
+    offset_s: np.ndarray  # (E,) s from departure
+    duration_s: np.ndarray  # (E,) s, > 0
+    landing: np.ndarray  # (E,) bool: a landing with its turnaround (else a take-off)
+    name: str = "pads"
+    description: str = "vertiport pads: at most n aircraft taking off, landing or turning around on a vertiport's pads"
+    shape = "cumulative"
+
+    @classmethod
+    def of(cls, flightset, pads: dict[str, int]) -> Pads:
+        names = tuple(sorted(pads))
+        where = {n: i for i, n in enumerate(names)}
+        rows = []
+        for i, f in enumerate(flightset.flights):
+            up, down, time = f.takeoff_s, f.landing_s, f.flight_time_s
+            if f.origin in where and up > 0:
+                rows.append((i, where[f.origin], 0.0, up, False))
+            hold = down + float(flightset.turnaround_after_s[i])
+            if f.destination in where and hold > 0:
+                rows.append((i, where[f.destination], time - down, hold, True))
+        cols = list(zip(*rows)) if rows else [[], [], [], [], []]
+        return cls(resources=names, capacity=np.array([pads[n] for n in names], dtype=np.int64),
+                   flight=np.array(cols[0], dtype=np.int64), resource=np.array(cols[1], dtype=np.int64),
+                   offset_s=np.array(cols[2], dtype=float), duration_s=np.array(cols[3], dtype=float),
+                   landing=np.array(cols[4], dtype=bool))
+
+    def record(self) -> dict:
+        return {"name": self.name, "shape": self.shape, "pads": {n: int(c) for n, c in zip(self.resources, self.capacity)}}
+
+    def _events_at(self, keep: np.ndarray) -> Pads:
+        return replace(self, flight=self.flight[keep], resource=self.resource[keep], offset_s=self.offset_s[keep],
+                       duration_s=self.duration_s[keep], landing=self.landing[keep])
+
+    def disjunctive(self) -> PairIntervals:
+        """The events at one-pad vertiports as pair intervals: no two may overlap."""
+        rows = []
+        single = self.capacity[self.resource] == 1
+        for r in np.flatnonzero(self.capacity == 1).tolist():
+            ev = np.flatnonzero(single & (self.resource == r)).tolist()
+            for x, a in enumerate(ev):
+                for b in ev[x + 1:]:
+                    fa, fb = int(self.flight[a]), int(self.flight[b])
+                    if fa == fb:
+                        continue
+                    oa, la, ob, lb = self.offset_s[a], self.duration_s[a], self.offset_s[b], self.duration_s[b]
+                    rows.append((fa, fb, float(oa - ob - lb), float(oa + la - ob)))
+        return PairIntervals.of_rows(self.name, rows, description="vertiport pads (one pad: no two holds overlap)")
+
+    def residual(self) -> Pads:
+        """The events at vertiports with more than one pad (the cumulative part)."""
+        return self._events_at(self.capacity[self.resource] > 1)
+
+    def violations(self, problem, operated, delay_s, tol_s) -> list[str]:
+        c = np.asarray(operated, dtype=bool)
+        dep = problem.planned_departure_s + np.where(c, delay_s, 0.0)
+        out = []
+        ids = problem.flights.ids
+        for r, name in enumerate(self.resources):
+            ev = np.flatnonzero((self.resource == r) & c[self.flight])
+            start = dep[self.flight[ev]] + self.offset_s[ev]
+            end = start + self.duration_s[ev]
+            for k, t in zip(ev.tolist(), start.tolist()):  # the load is largest at some start
+                on = ev[(start <= t + tol_s) & (end > t + tol_s)]
+                if len(on) > self.capacity[r]:
+                    who = ", ".join(ids[int(self.flight[j])] for j in on)
+                    out.append(f"vertiport {name}: {len(on)} aircraft on {int(self.capacity[r])} pad(s) at "
+                               f"{t:.3f} s ({who}) ({self.name})")
+                    break
+        return out
+
+
+def from_scenario(flightset, scenario) -> Pads | None:
+    """The family when any vertiport has a pad limit (``network.pads`` or a vertiport's ``pads``)."""
+    pads = scenario.network.pads_of()
+    return None if pads is None else Pads.of(flightset, pads)
