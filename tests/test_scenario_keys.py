@@ -160,6 +160,10 @@ def test_every_scenario_key_is_read(tmp_path, network_file, monkeypatch):
     # synthetic city: risk, tracks, network, plan, schedule
     assert main(["plan", str(PAPER_CASE), "--out", str(tmp_path / "plan")]) == 0
     assert main(["schedule", str(PAPER_CASE), "--solver", "greedy", "--out", str(tmp_path / "sched")]) == 0
+    # the vertiport variant: vertical phases at the aircraft's climb rate, pads
+    assert main(["schedule", str(PAPER_CASE), "--solver", "greedy", "--out", str(tmp_path / "vertiport"),
+                 "--set", 'network.tracks="straight"', "--set", "network.vertical_phases=true",
+                 "--set", "network.pads=1", "--set", "schedule.aircraft=4", "--set", "schedule.flights=16"]) == 0
     # the instance generator: random vertiports, straight tracks
     flights_command(tmp_path / "ladder")
     # OpenStreetMap city (bundled Helsinki extract), coarse cells

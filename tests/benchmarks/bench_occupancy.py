@@ -46,7 +46,7 @@ from uamopt.schedule import (
     write_schedule,
 )
 from uamopt.schedule.occupancy import MAX_TRACK_PAIRS, candidate_pairs, track_pair_gaps
-from uamopt.schedule.plan import track_length_m
+from uamopt.schedule.flights import track_length_m
 from uamopt.schedule.verify import verify_dir
 
 
