@@ -142,6 +142,13 @@ def test_a_vertiport_missing_from_the_record_is_a_violation(tmp_path):
     assert len(found) == 1 and "vertiport V3 has no pad capacity in the pads record" in found[0]
 
 
+def test_a_null_capacity_is_unlimited(tmp_path):
+    # the overlap at V2 of test_one_pad_landing_hold_overlapping_a_take_off... is no violation where V2
+    # has no limit (null), and V3 null is not "missing"
+    assert verify_dir(two_at_v2(tmp_path, "null", 100.0, V1=1, V2=None, V3=None)) == []
+    assert len(verify_dir(two_at_v2(tmp_path, "limited", 100.0, V1=1, V2=1, V3=None))) == 1
+
+
 def test_without_vertical_phases_only_the_turnaround_is_held(tmp_path):
     # cruise-only tracks at z = 120 m: climb_s = descent_s = 0, F1 (leg 1 of A1) V1 -> V2 in
     # 500 / 25 = 20 s, holds V2 during [20, 20 + 60); F2 (leg 2 of A1) V2 -> V1 at 80 s, 20 s,

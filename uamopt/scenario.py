@@ -213,11 +213,13 @@ class NetworkConfig(_Section):
         "its pads at once, taking off, landing, or turning around (T_D/T_R) after landing (family pads, "
         "docs/variants.md); omitted: unlimited, the paper's model")
 
-    def pads_of(self) -> dict[str, int] | None:
-        """Pads per vertiport name (a vertiport's own ``pads``, else ``pads``); None when no vertiport
-        has a limit (the paper's model). A vertiport without either has unlimited pads, left out."""
+    def pads_of(self) -> dict[str, int | None] | None:
+        """Pads per vertiport name (a vertiport's own ``pads``, else ``pads``; None: unlimited);
+        None when no vertiport has a limit (the paper's model)."""
         out = {v.name: v.pads if v.pads is not None else self.pads for v in self.vertiports}
-        return {k: int(v) for k, v in out.items() if v is not None} or None
+        if all(v is None for v in out.values()):
+            return None
+        return {k: None if v is None else int(v) for k, v in out.items()}
 
     def route_list(self) -> list[tuple[str, str]]:
         """The routes (a, b): ``routes`` as given, or every pair of vertiports in their order

@@ -133,7 +133,8 @@ class SchedulingProblem:
         from uamopt.schedule.families.pairs import merged
 
         # a cumulative family's one-pad resources are pairs too (families/pads.py)
-        p, q, ptr, intervals = merged(self.of_shape("pairs") + [f.disjunctive() for f in self.of_shape("cumulative")])
+        p, q, ptr, intervals = merged(self.of_shape("pairs") + [f.disjunctive(self.planned_departure_s, self.delay_upper_s)
+                                                              for f in self.of_shape("cumulative")])
         return pair_view(p, q, ptr, intervals, self.planned_departure_s, self.delay_upper_s)
 
     @property

@@ -16,7 +16,8 @@ the verifier does not know is a violation ("cannot be checked"), never a pass.
   recomputed (lexicographic: the delay weight over every speed of every flight).
 - ``departure_spacing`` with ``spacing_s``: operated flights that start at one point (the first
   waypoint of flights.json: one vertiport) depart at least ``spacing_s`` apart.
-- ``pads`` (shape ``cumulative``) with ``pads`` {vertiport: capacity, an integer ≥ 1}: an operated
+- ``pads`` (shape ``cumulative``) with ``pads`` {vertiport: capacity, an integer ≥ 1, or null for a
+  vertiport without a limit, which is not checked}: an operated
   flight holds one pad of its ``origin`` (flights.json) during [departure, departure + climb_s)
   and one of its ``destination`` during [arrival − descent_s, arrival + ΔT), ΔT its turnaround gap
   (outbound_gap_s after an odd leg of its aircraft, return_gap_s after an even leg); climb_s and
@@ -119,8 +120,9 @@ def _check_pads(record: dict, flown: list[dict], where: str) -> list[str]:
     earlier so that holds overlapping by at most ``TOL_S`` do not count together."""
     pads = record.get("pads")
     if not isinstance(pads, dict) or not all(
-            isinstance(c, int) and not isinstance(c, bool) and c >= 1 for c in pads.values()):
-        raise InputFileError(f"pads: 'pads' must be an object of vertiport name -> capacity (an integer ≥ 1), got {pads!r}",
+            c is None or (isinstance(c, int) and not isinstance(c, bool) and c >= 1) for c in pads.values()):
+        raise InputFileError(f"pads: 'pads' must be an object of vertiport name -> capacity (an integer ≥ 1, or null "
+                             f"for unlimited), got {pads!r}",
                              where, "rewrite it with uamopt schedule")
     out: list[str] = []
     holds: dict[str, list[tuple[float, float, str]]] = {}
@@ -145,6 +147,8 @@ def _check_pads(record: dict, flown: list[dict], where: str) -> list[str]:
                        + (f" (flights {', '.join(users)} hold a pad there)" if users else ""))
             continue
         cap = pads[port]
+        if cap is None:  # unlimited
+            continue
         events = []  # (time, 0 = end / 1 = start, hold number)
         for n, (a, b, _) in enumerate(holds[port]):
             events.append((a, 1, n))

@@ -39,12 +39,17 @@ class Pads:
     offset_s: np.ndarray  # (E,) s from departure
     duration_s: np.ndarray  # (E,) s, > 0
     landing: np.ndarray  # (E,) bool: a landing with its turnaround (else a take-off)
+    #: vertiports of the network without a pad limit (recorded as null: the verifier skips them)
+    unlimited: tuple[str, ...] = ()
     name: str = "pads"
     description: str = "vertiport pads: at most n aircraft taking off, landing or turning around on a vertiport's pads"
     shape = "cumulative"
 
     @classmethod
-    def of(cls, flightset, pads: dict[str, int]) -> Pads:
+    def of(cls, flightset, pads: dict[str, int | None]) -> Pads:
+        """Pads ``{vertiport: capacity}``; a capacity None is unlimited (no event, recorded as null)."""
+        unlimited = tuple(sorted(n for n, c in pads.items() if c is None))
+        pads = {n: c for n, c in pads.items() if c is not None}
         names = tuple(sorted(pads))
         where = {n: i for i, n in enumerate(names)}
         rows = []
@@ -59,28 +64,52 @@ class Pads:
         return cls(resources=names, capacity=np.array([pads[n] for n in names], dtype=np.int64),
                    flight=np.array(cols[0], dtype=np.int64), resource=np.array(cols[1], dtype=np.int64),
                    offset_s=np.array(cols[2], dtype=float), duration_s=np.array(cols[3], dtype=float),
-                   landing=np.array(cols[4], dtype=bool))
+                   landing=np.array(cols[4], dtype=bool), unlimited=unlimited)
 
     def record(self) -> dict:
-        return {"name": self.name, "shape": self.shape, "pads": {n: int(c) for n, c in zip(self.resources, self.capacity)}}
+        """Every vertiport of the network: its capacity, null where unlimited."""
+        pads: dict[str, int | None] = {n: int(c) for n, c in zip(self.resources, self.capacity)}
+        pads |= {n: None for n in self.unlimited}
+        return {"name": self.name, "shape": self.shape, "pads": dict(sorted(pads.items()))}
 
     def _events_at(self, keep: np.ndarray) -> Pads:
         return replace(self, flight=self.flight[keep], resource=self.resource[keep], offset_s=self.offset_s[keep],
                        duration_s=self.duration_s[keep], landing=self.landing[keep])
 
-    def disjunctive(self) -> PairIntervals:
-        """The events at one-pad vertiports as pair intervals: no two may overlap."""
-        rows = []
+    def disjunctive(self, planned_s=None, upper_s=None) -> PairIntervals:
+        """The events at one-pad vertiports as pair intervals: no two may overlap.
+
+        With the planned departures ``planned_s`` and the largest delays ``upper_s``, only the pairs
+        that can meet are kept: event k can only lie in [P + o_k, P + U + o_k + l_k) of its flight,
+        and two events whose windows do not overlap never conflict (a pruning, not a relaxation)."""
+        blocks = []
         single = self.capacity[self.resource] == 1
         for r in np.flatnonzero(self.capacity == 1).tolist():
-            ev = np.flatnonzero(single & (self.resource == r)).tolist()
-            for x, a in enumerate(ev):
-                for b in ev[x + 1:]:
-                    fa, fb = int(self.flight[a]), int(self.flight[b])
-                    if fa == fb:
-                        continue
-                    oa, la, ob, lb = self.offset_s[a], self.duration_s[a], self.offset_s[b], self.duration_s[b]
-                    rows.append((fa, fb, float(oa - ob - lb), float(oa + la - ob)))
+            ev = np.flatnonzero(single & (self.resource == r))
+            if planned_s is None:
+                lo_w = np.zeros(len(ev))
+                hi_w = np.full(len(ev), np.inf)
+            else:
+                base = np.asarray(planned_s, dtype=float)[self.flight[ev]] + self.offset_s[ev]
+                lo_w = base
+                hi_w = base + np.asarray(upper_s, dtype=float)[self.flight[ev]] + self.duration_s[ev]
+            order = np.argsort(lo_w, kind="stable")
+            ev, lo_w, hi_w = ev[order], lo_w[order], hi_w[order]
+            # partners of x: the later-sorted events whose window opens before x's closes
+            stop = np.searchsorted(lo_w, hi_w, side="left")
+            count = np.maximum(stop - np.arange(len(ev)) - 1, 0)
+            a = np.repeat(np.arange(len(ev)), count)
+            if not len(a):
+                continue
+            first = np.repeat(np.cumsum(count) - count, count)
+            b = a + 1 + (np.arange(len(a)) - first)
+            a, b = ev[a], ev[b]
+            keep = self.flight[a] != self.flight[b]
+            blocks.append((a[keep], b[keep]))
+        a = np.concatenate([x for x, _ in blocks]) if blocks else np.zeros(0, dtype=np.int64)
+        b = np.concatenate([y for _, y in blocks]) if blocks else np.zeros(0, dtype=np.int64)
+        oa, la, ob, lb = self.offset_s[a], self.duration_s[a], self.offset_s[b], self.duration_s[b]
+        rows = list(zip(self.flight[a].tolist(), self.flight[b].tolist(), (oa - ob - lb).tolist(), (oa + la - ob).tolist()))
         return PairIntervals.of_rows(self.name, rows, description="vertiport pads (one pad: no two holds overlap)")
 
     def residual(self) -> Pads:
