@@ -12,6 +12,8 @@
   of planned flights operated per total planned flights ``schedule.flights`` or cruise speed
   ``aircraft.cruise_speed_mps``, one line per solver (the preliminary strategy ``greedy`` is the
   paper's "before optimization"), median over seeds with the seeds' range as a band.
+- ``"pads"`` (the vertiport variant, docs/variants.md): the same two panels per pads per
+  vertiport ``network.pads``.
 
 Without ``kind``, any sweep table: ``plot_sweep(table, x=..., hue=..., y=...)`` draws the metric
 ``y`` against the swept key ``x``, one line per value of ``hue`` (a second key, or the solver),
@@ -29,7 +31,7 @@ import numpy as np
 
 #: swept key of each study (its x axis)
 KEYS = {"altitude": "network.cruise_altitude_m", "cell": "grid.cell", "weights": "tracks.weights",
-        "flights": "schedule.flights", "speed": "aircraft.cruise_speed_mps"}
+        "flights": "schedule.flights", "speed": "aircraft.cruise_speed_mps", "pads": "network.pads"}
 #: the paper's Table 4 (optimal tracks at 10 m and 5 m cells): risk, ¥, waypoints, seconds
 PAPER_TABLE4 = {"[10.0, 10.0, 10.0]": (196.0, 27.1527, 386, 68.71), "[5.0, 5.0, 5.0]": (163.33, 25.7975, 636, 659.52)}
 #: the metric drawn when ``y`` is not given, by the stage the sweep ran to
@@ -52,6 +54,7 @@ LABELS = {
     "schedule.flights": "total planned flights F", "aircraft.cruise_speed_mps": "cruise speed v_g (m/s)",
     "network.cruise_altitude_m": "cruise altitude h (m)", "grid.cell": "cell (Δx, Δy, Δz) (m)",
     "tracks.weights": "weights (ω4, ω5)", "schedule.aircraft": "aircraft G",
+    "network.pads": "pads per vertiport (FATO)",
 }
 MAX_PANELS = 12  # one panel per value of the keys left over; more is a table to filter first
 MAX_TICK_LABELS = 12  # categorical x: more labels than this are thinned
@@ -321,7 +324,7 @@ def plot_sweep(table, kind: str | None = None, ax=None, *, x: str | None = None,
     Axes (the first panel), or one Axes per panel.
 
     ``kind`` names one of the paper's studies (module docstring: ``"altitude"``, ``"cell"``,
-    ``"weights"``, ``"flights"``, ``"speed"``). Without it, any sweep table:
+    ``"weights"``, ``"flights"``, ``"speed"``, ``"pads"``). Without it, any sweep table:
 
     - ``x``: the column on the x axis, numeric (drawn to scale, a tick per value up to 12) or
       categorical (list values such as ``grid.cell`` as "[10, 10, 10]", in grid order; long
@@ -358,8 +361,8 @@ def plot_sweep(table, kind: str | None = None, ax=None, *, x: str | None = None,
     key = KEYS[kind]
     if key not in table.columns:
         raise UamoptError(f"figure '{kind}' needs the swept key '{key}'", "sweep figure", f"sweep \"{key}\" in [grid]")
-    if kind in ("flights", "speed"):
-        return _delays(table, key, ax, {"flights": "total planned flights F", "speed": "cruise speed v_g (m/s)"}[kind])
+    if kind in ("flights", "speed", "pads"):
+        return _delays(table, key, ax, LABELS[key])
     return {"altitude": _altitude, "cell": _cell, "weights": _weights}[kind](table, key, ax)
 
 
