@@ -101,13 +101,24 @@ def cmd_schedule(args) -> int:
     return 0
 
 
+def _printable(text: str) -> str:
+    """``text`` on one line: a control character a crafted folder put in an id or a path (a newline,
+    NUL, ESC) is shown escaped, as Python writes it in a string (``\\n``, ``\\x00``)."""
+    return "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
+
+
 def cmd_verify(args) -> int:
+    """Read-only: verify writes nothing, so input it refuses leaves nothing behind."""
     from uamopt.schedule.verify import verify_dir
 
-    problems = verify_dir(args.dir)
+    try:
+        problems = verify_dir(args.dir)
+    except UamoptError as exc:  # the folder is untrusted: its error line must stay one line
+        sys.stderr.write(f"error: {_printable(exc.line())}\n")
+        return EXIT_BAD_INPUT
     for line in problems:
-        print(line)
-    print(f"{len(problems)} violations" if problems else f"feasible and conflict-free: {args.dir}")
+        print(_printable(line))
+    print(f"{len(problems)} violations" if problems else f"feasible and conflict-free: {_printable(str(args.dir))}")
     return 1 if problems else 0
 
 

@@ -26,15 +26,22 @@ the float round-off of that magnitude, ``close_s``):
   phases count like any other segment, timed at the vertical rate;
 - the extra families summary.json lists (``pads``, ``departure_spacing``, ...:
   uamopt/schedule/verify_variants.py);
-- summary.json's counts, delays and (when its weights are given) objective agree.
+- summary.json's counts (``flights`` and ``aircraft`` when it records them, operated, cancelled),
+  delays and (when its weights are given) objective agree. A folder without flights (an empty
+  flights list, a header-only schedule.csv) is trivially feasible when summary.json agrees (its
+  average delay over G = 0 aircraft is 0); a summary that claims flights the files lack is a
+  violation.
 
 The folder is untrusted input: a field out of its range (a negative or non-integer conflict
 radius, a cell that is not positive, waypoints that are not finite or lie outside the local
-frame, a speed outside 0.1–200 m/s, a ``vertical_rate_mps`` outside (0, 50] m/s or without a
-vertical first and last segment, times beyond 10⁷ s, a flight id twice, a conflict search
-beyond ``MAX_VISITS`` cells (millimetre cells), a summary that is not an object or whose weights
-are not two numbers, text that is not UTF-8) is an ``InputFileError`` (exit 2), never a pass; a
-waypoint outside the grid ``extent_m`` that summary.json records is a violation (exit 1).
+frame, a number beyond the float range (a JSON integer of 400 digits), JSON that Python cannot
+read (an integer of more than 4300 digits), a short row of schedule.csv, a speed outside
+0.1–200 m/s, a ``vertical_rate_mps`` outside (0, 50] m/s or without a vertical first and last
+segment, times beyond 10⁷ s, a flight id twice, a conflict search beyond ``MAX_VISITS`` cells
+(millimetre cells), a summary that is not an object or whose weights are not two finite
+numbers, text that is not UTF-8) is an ``InputFileError`` (exit 2), never a pass; a waypoint
+outside the grid ``extent_m`` that summary.json records is a violation (exit 1). Verify only
+reads: a folder it refuses leaves nothing written.
 
 Cell convention (shared by definition with the model, not by code): cell = floor(coordinate / Δ);
 when a segment starts exactly on a plane and moves down that axis it is in the lower cell; a
@@ -45,13 +52,12 @@ from __future__ import annotations
 
 import csv
 import itertools
-import json
 import math
 from collections import defaultdict
 from pathlib import Path
 
 from uamopt.errors import InputFileError
-from uamopt.schedule.verify_summary import TOL_S, check_summary
+from uamopt.schedule.verify_summary import TOL_S, check_summary, read_json, shown
 
 TIE_S = 1e-9  # crossings closer than this are simultaneous, s
 BUCKET_S = 30.0  # time bucket of the conflict hash, s
@@ -140,30 +146,39 @@ def cell_visits(waypoints, speed_mps: float, cell,
 def _number(value, what: str, where: str) -> float:
     try:
         out = float(value)
+    except OverflowError:  # an integer beyond the float range (JSON allows 400 digits)
+        out = math.inf
     except (TypeError, ValueError):
-        raise InputFileError(f"{what} is not a number: {value!r}", where, "rewrite the file with uamopt schedule") from None
+        raise InputFileError(f"{what} is not a number: {shown(value)}", where, "rewrite the file with uamopt schedule") from None
     if not math.isfinite(out):
-        raise InputFileError(f"{what} is not finite: {value!r}", where, "rewrite the file with uamopt schedule")
+        raise InputFileError(f"{what} is not finite: {shown(value)}", where, "rewrite the file with uamopt schedule")
     return out
+
+
+def _coordinate(value) -> float:
+    """A waypoint coordinate as a float; an integer beyond the float range (400 digits) is inf,
+    which the finite check then refuses."""
+    try:
+        return float(value)
+    except OverflowError:
+        return math.inf
 
 
 def _read_flights(path: Path) -> dict:
     if not path.is_file():
         raise InputFileError(f"missing {path.name}", str(path.parent), "give a folder written by uamopt schedule")
+    raw = read_json(path)
     try:
-        raw = json.loads(path.read_text(encoding="utf-8-sig"))
         flights = raw["flights"]
         cell = [_number(c, "cell", str(path)) for c in raw["cell"]]
-    except (json.JSONDecodeError, UnicodeDecodeError, RecursionError, OSError) as exc:
-        raise InputFileError(f"malformed JSON: {exc}", str(path), "rewrite the file with uamopt schedule") from None
     except (KeyError, TypeError, ValueError):
         raise InputFileError("missing or malformed 'flights' or 'cell'", str(path), "rewrite the file with uamopt schedule") from None
     if len(cell) != 3 or min(cell) <= 0 or not isinstance(flights, list):
-        raise InputFileError(f"cell must be three positive sizes in metres and flights a list, got cell {raw['cell']!r}",
+        raise InputFileError(f"cell must be three positive sizes in metres and flights a list, got cell {shown(raw['cell'])}",
                              str(path), "rewrite the file with uamopt schedule")
     radius = raw.get("conflict_radius", 1)
     if isinstance(radius, bool) or not isinstance(radius, int) or not 0 <= radius <= MAX_RADIUS:
-        raise InputFileError(f"conflict_radius must be an integer in [0, {MAX_RADIUS}], got {radius!r}", str(path),
+        raise InputFileError(f"conflict_radius must be an integer in [0, {MAX_RADIUS}], got {shown(radius)}", str(path),
                              "rewrite the file with uamopt schedule (the scenario's schedule.conflict_radius)")
     out = {
         "cell": cell, "radius": radius, "flights": [],
@@ -179,11 +194,11 @@ def _read_flights(path: Path) -> dict:
                              "rewrite the file with uamopt schedule")
     seen: set[str] = set()
     for f in flights:
-        where = f"{path}: flight {f.get('id') if isinstance(f, dict) else '?'}"
+        where = f"{path}: flight {str(f.get('id'))[:40] if isinstance(f, dict) else '?'}"
         if not isinstance(f, dict) or "waypoints" not in f:
             raise InputFileError("flight without waypoints", where, "the verifier needs self-contained flights (uamopt schedule writes them)")
         try:
-            wps = [tuple(float(v) for v in p) for p in f["waypoints"]]
+            wps = [tuple(_coordinate(v) for v in p) for p in f["waypoints"]]
             rec = {
                 "id": str(f["id"]), "aircraft": str(f["aircraft"]), "route": str(f["route"]),
                 "speed": _number(f["speed_mps"], "speed_mps", where),
@@ -206,7 +221,7 @@ def _read_flights(path: Path) -> dict:
             raise InputFileError(f"waypoints outside the local frame [0, {MAX_COORD_M:g}] m (below the ground datum "
                                  "or west/south of the grid's origin)", where, "rewrite the file with uamopt schedule")
         if rec["id"] in seen:
-            raise InputFileError(f"flight id {rec['id']!r} appears twice", where, "give every flight its own id")
+            raise InputFileError(f"flight id {shown(rec['id'])} appears twice", where, "give every flight its own id")
         seen.add(rec["id"])
         rec["length"] = sum(math.dist(a, b) for a, b in itertools.pairwise(wps))
         rec["origin"] = None if f.get("origin") is None else str(f["origin"])
@@ -227,9 +242,9 @@ def _phases(rec: dict, rate, where: str) -> None:
                    cruise_s=rec["length"] / rec["speed"], duration=rec["length"] / rec["speed"],
                    segment_speeds=[rec["speed"]] * n)
         return
-    if isinstance(rate, bool) or not isinstance(rate, (int, float)) or not math.isfinite(rate) \
-            or not 0 < rate <= VERTICAL_RATE_MPS:
-        raise InputFileError(f"flight {rec['id']}: vertical_rate_mps must be a number in (0, {VERTICAL_RATE_MPS:g}] m/s, got {rate!r}", where,
+    # the range first: it is exact on an integer of any size (math.isfinite would overflow) and refuses NaN and inf
+    if isinstance(rate, bool) or not isinstance(rate, (int, float)) or not 0 < rate <= VERTICAL_RATE_MPS:
+        raise InputFileError(f"flight {rec['id']}: vertical_rate_mps must be a number in (0, {VERTICAL_RATE_MPS:g}] m/s, got {shown(rate)}", where,
                              "rewrite the file with uamopt schedule")
     rate = float(rate)
 
@@ -286,9 +301,12 @@ def _parse_schedule(path: Path, rows: dict[str, dict]) -> dict[str, dict]:
             raise InputFileError(f"schedule.csv needs the columns {','.join(COLUMNS)}", str(path), "rewrite it with uamopt schedule")
         for n, row in enumerate(reader, start=2):
             where = f"{path}: line {n}"
+            if any(row.get(c) is None for c in COLUMNS[:5]):  # a short row: DictReader fills the missing fields with None
+                raise InputFileError(f"line {n} has fewer fields than the header's {len(reader.fieldnames)} columns", where,
+                                     "rewrite it with uamopt schedule")
             flag = row["operated"].strip().lower()
             if flag not in ("1", "0", "true", "false"):
-                raise InputFileError(f"operated must be 1 or 0, got {row['operated']!r}", where, "rewrite it with uamopt schedule")
+                raise InputFileError(f"operated must be 1 or 0, got {shown(row['operated'])}", where, "rewrite it with uamopt schedule")
             on = flag in ("1", "true")
             rec = {"row": row, "line": n, "operated": on, "duplicate": row["flight"] in rows,
                    "planned": _number(row["planned_departure_s"], "planned_departure_s", where),

@@ -30,17 +30,28 @@ the verifier does not know is a violation ("cannot be checked"), never a pass.
 from __future__ import annotations
 
 import hashlib
+import math
 from pathlib import Path
 
 from uamopt.errors import InputFileError
-from uamopt.schedule.verify_summary import TOL_S
+from uamopt.schedule.verify_summary import TOL_S, finite, shown
 
 TOL = 1e-6  # on landing times and the objective (relative above 1)
+MAX_AIRLAND_BYTES = 64 * 2 ** 20  # the largest OR-Library airland file is about 2 MB
+
+
+def _objective_off(got, expect: float) -> bool:
+    """summary.json's objective ``got`` is not ``expect`` within ``TOL`` (relative above 1); a value
+    that is not a finite number (NaN, inf, a 400-digit integer, a string) is always off."""
+    return not finite(got) or not math.isfinite(expect) or abs(float(got) - expect) > TOL * max(1.0, abs(expect))
 
 
 def _airland(path: Path, digest: str | None, where: str) -> tuple[list[list[float]], list[list[float]]]:
     """(per aircraft [appearance, E, T, L, g, h], separation rows) of an airland file."""
     try:
+        if not path.is_file() or path.stat().st_size > MAX_AIRLAND_BYTES:  # /dev/zero or a FIFO would be read forever
+            raise InputFileError(f"the instance file {path} is not a regular file of at most {MAX_AIRLAND_BYTES // 2 ** 20} MB",
+                                 where, "give the OR-Library airland file the schedule was made from")
         data = path.read_bytes()
     except OSError as exc:
         raise InputFileError(f"cannot read the instance file {path}: {exc.strerror or exc}", where,
@@ -52,7 +63,8 @@ def _airland(path: Path, digest: str | None, where: str) -> tuple[list[list[floa
         numbers = [float(x) for x in data.decode("utf-8").split()]
     except (UnicodeDecodeError, ValueError):
         raise InputFileError(f"the instance file {path} is not an airland file", where, "give the OR-Library file") from None
-    count = int(numbers[0]) if numbers else 0
+    # every number finite (int() of inf or NaN raises; a NaN window would pass every comparison) and a whole count
+    count = int(numbers[0]) if numbers and all(math.isfinite(x) for x in numbers) and numbers[0] == int(numbers[0]) else 0
     if count < 1 or len(numbers) != 2 + count * (6 + count):
         raise InputFileError(f"the instance file {path} is not an airland file", where, "give the OR-Library file")
     head, sep, at = [], [], 2
@@ -84,8 +96,8 @@ def _check_airland(record: dict, summary: dict, landing: dict[str, float | None]
     if all(x is not None for x in times) and summary.get("objective") is not None:
         cost = sum(g * max(0.0, t - x) + h * max(0.0, x - t) for (_, _, t, _, g, h), x in zip(head, times))
         got = summary["objective"]
-        if not isinstance(got, (int, float)) or abs(got - cost) > TOL * max(1.0, abs(cost)):
-            out.append(f"summary.json: objective = {got!r}, the landing times cost {cost:.6g} (earliness/tardiness)")
+        if _objective_off(got, cost):
+            out.append(f"summary.json: objective = {shown(got)}, the landing times cost {cost:.6g} (earliness/tardiness)")
     return out
 
 
@@ -175,14 +187,15 @@ def _check_speeds(record: dict, summary: dict, spec: dict, flown: list[dict], wh
     """Each operated flight's speed (flights.json) is an allowed factor of its cruise speed, and the
     objective with the change costs (weights, or the lexicographic weight over every speed copy)."""
     factors, cruise, cost = record.get("factors"), record.get("cruise_speed_mps"), record.get("change_cost_s", 0.0)
-    if not (isinstance(factors, list) and factors and all(isinstance(k, (int, float)) and 0 < k <= 1 for k in factors)
-            and isinstance(cruise, dict) and isinstance(cost, (int, float)) and cost >= 0):
-        raise InputFileError("speed_choice: factors, cruise_speed_mps or change_cost_s malformed", where,
+    if not (isinstance(factors, list) and factors and all(finite(k) and 0 < k <= 1 for k in factors)
+            and isinstance(cruise, dict) and all(finite(v) for v in cruise.values()) and finite(cost) and cost >= 0):
+        raise InputFileError("speed_choice: factors, cruise_speed_mps or change_cost_s malformed (finite numbers: "
+                             "factors in (0, 1], cruise speeds in m/s, a change cost ≥ 0 s)", where,
                              "rewrite it with uamopt schedule")
     out, changed = [], 0
     for f in flown:
         v = cruise.get(f["id"])
-        if not isinstance(v, (int, float)) or v <= 0:
+        if not finite(v) or v <= 0:
             raise InputFileError(f"speed_choice: no cruise speed for flight {f['id']}", where, "rewrite it with uamopt schedule")
         match = [k for k in factors if abs(f["speed"] - k * v) <= 1e-9 * max(1.0, v)]
         if not match:
@@ -197,7 +210,8 @@ def _check_speeds(record: dict, summary: dict, spec: dict, flown: list[dict], wh
         from uamopt.schedule.verify_summary import read_weights
 
         w6, w7 = read_weights(summary.get("weights"), where)
-        expect = w6 * total / len({f["aircraft"] for f in spec["flights"]}) - w7 * len(flown)
+        n_aircraft = len({f["aircraft"] for f in spec["flights"]})
+        expect = (w6 * total / n_aircraft if n_aircraft else 0.0) - w7 * len(flown)  # no aircraft: no delay
     else:
         upper = 0.0
         for f in spec["flights"]:
@@ -208,8 +222,8 @@ def _check_speeds(record: dict, summary: dict, spec: dict, flown: list[dict], wh
                 upper += float(cost) if k != 1.0 else 0.0
         expect = -len(flown) + total / (upper + 1.0)
     got = summary["objective"]
-    if not isinstance(got, (int, float)) or abs(got - expect) > TOL * max(1.0, abs(expect)):
-        out.append(f"summary.json: objective = {got!r}, the schedule at its speeds gives {expect:.6g}")
+    if _objective_off(got, expect):
+        out.append(f"summary.json: objective = {shown(got)}, the schedule at its speeds gives {expect:.6g}")
     return out
 
 
