@@ -28,6 +28,16 @@ Faithful to the plan, within what the simulator can do (measured figures in docs
   off, so climbs follow the planned gradient.
 - Detection: ``CDMETHOD STATEBASED``, resolution off, protected zone (``ZONER``, ``ZONEDH``) from
   the replay's zone (see :func:`uamopt.sim.zone.protected_zone`).
+- Vertical phases (the vertiport variant: a flight with ``vertical_rate_mps``, first and last
+  segments vertical): the aircraft is created on its vertiport's pad at the departure, hovering
+  (speed 0), and climbs with ``ALT`` at the vertical rate; its cruise (the segments between, designed
+  as above) is its LNAV route. The plan jumps from hover to v_g at the top of climb, which no
+  aircraft can: BlueSky's rotorcraft accelerate at a = 3.5 m/s² (``ROTOR_ACCEL_MPS2``), so the
+  speed is commanded v/(2a) before the top of climb, and 0 v/(2a) before the top of descent, which
+  keeps the aircraft within v²/(8a) of the plan through each transition (22.3 m at 25 m/s:
+  ``transition_error_m``, beyond the default budget e_h, so the replay lists these flights as over
+  budget; docs/export.md). At the top of descent ``ALT`` takes it down at the vertical rate to the
+  ground, where it is deleted at its planned arrival.
 """
 
 from __future__ import annotations
@@ -55,6 +65,9 @@ KT_MPS = 1852.0 / 3600.0
 NM_M = 1852.0
 R_EARTH_BLUESKY_M = 6371000.0  # bluesky.tools.aero.Rearth: the sphere aircraft move on
 AIRCRAFT_TYPE = "EC35"
+#: BlueSky 1.1.1's horizontal acceleration of every rotorcraft, m/s² (``axmax_rotor`` in
+#: bluesky/traffic/performance/openap/perfoap.py ``calc_axmax``)
+ROTOR_ACCEL_MPS2 = 3.5
 
 
 def tas_to_cas(tas_mps: np.ndarray, altitude_m: np.ndarray) -> np.ndarray:
@@ -117,7 +130,8 @@ def _stamp(t_s: float) -> str:
 
 def flight_trajectories(flights: Sequence, bank_deg: float = DEFAULT_BANK_DEG,
                         trajectory: str = DEFAULT_TRAJECTORY) -> dict[str, Trajectory]:
-    """What each operated flight commands, times from its departure: flight id -> :class:`Trajectory`.
+    """What each operated flight commands, times from its departure (with vertical phases: from the
+    top of climb, the cruise only): flight id -> :class:`Trajectory`.
 
     ``trajectory = "designed"``: the flyable trajectory nearest to the plan
     (:func:`~uamopt.export.trajectory.flyable_trajectory`, designed once per track);
@@ -129,6 +143,8 @@ def flight_trajectories(flights: Sequence, bank_deg: float = DEFAULT_BANK_DEG,
     out = {}
     for o in flights:
         wp = np.asarray(o.flight.waypoints, float)
+        if o.flight.vertical_rate_mps is not None:
+            wp = wp[1:-1]  # the cruise: the vertical phases are flown with ALT (vertical_commands)
         if trajectory == "waypoints":
             out[o.flight.id] = plan_trajectory(wp, o.flight.speed_mps)
             continue
@@ -163,6 +179,47 @@ def flight_commands(acid: str, trajectory: Trajectory, frame, bank_deg: float) -
     return lines
 
 
+def transition_error_m(speed_mps: float, accel_mps2: float = ROTOR_ACCEL_MPS2) -> float:
+    """v²/(8a): the largest horizontal distance to the plan of a speed change 0 ↔ v at acceleration a
+    centred on the plan's instant jump (started v/(2a) before it), m (module docstring)."""
+    return speed_mps * speed_mps / (8.0 * accel_mps2)
+
+
+def vertical_commands(acid: str, o, cruise: Trajectory, frame, bank_deg: float, dt_s: float) -> list[tuple[float, str]]:
+    """(clock time, command) of one flight with vertical phases (module docstring): created on the
+    ground hovering, ALT up at the vertical rate, the cruise ``cruise`` (times from the top of climb)
+    as its LNAV/VNAV route with the speed commanded v/(2a) early, speed 0 v/(2a) before the top of
+    descent, ALT down, DEL at the arrival."""
+    f = o.flight
+    rate = float(f.vertical_rate_mps)
+    wp = np.asarray(f.waypoints, float)
+    top, tod = o.departure_s + f.takeoff_s, o.arrival_s - f.landing_s  # top of climb, top of descent
+    points, times = cruise.points, cruise.times_s
+    lon, lat = frame.to_lonlat(points[:, 0], points[:, 1])
+    z = points[:, 2]
+    ground = sphere_distance_m(lon[:-1], lat[:-1], lon[1:], lat[1:])
+    tas = ground / np.diff(times)
+    cas_kt = tas_to_cas(tas, 0.5 * (z[:-1] + z[1:])) / KT_MPS
+    cas_kt = np.append(cas_kt, cas_kt[-1])
+    alt_ft = np.maximum(z / FT_M, 0.1)
+    rate_fpm = rate / FT_M * 60.0
+    t_k = first_step_s(o.departure_s, dt_s)
+    z0 = min(wp[0, 2] + rate * (t_k - o.departure_s), wp[1, 2])  # where the climb is at t_k
+    glon, glat = frame.to_lonlat(wp[0, 0], wp[0, 1])
+    hdg = sphere_bearing_deg(float(glon), float(glat), lon[1], lat[1])
+    at = t_k
+    out = [(at, f"CRE {acid} {AIRCRAFT_TYPE} {float(glat):.8f} {float(glon):.8f} {hdg:.3f} {max(z0 / FT_M, 0.1):.2f} 0"),
+           (at, f"BANK {acid} {bank_deg:g}"), (at, f"SWTOC {acid} OFF"), (at, f"SWTOD {acid} OFF")]
+    out += [(at, f"ADDWPT {acid} {lat[i]:.8f} {lon[i]:.8f} {alt_ft[i]:.2f} {cas_kt[i]:.4f}") for i in range(1, len(z))]
+    out += [(at, f"LNAV {acid} ON"), (at, f"ALT {acid} {alt_ft[0]:.2f} {rate_fpm:.3f}")]
+    a = ROTOR_ACCEL_MPS2
+    out += [(max(top - tas[0] / (2 * a), at), f"SPD {acid} {cas_kt[0]:.4f}"), (max(top, at), f"VNAV {acid} ON"),
+            (max(tod - tas[-1] / (2 * a), at), f"SPD {acid} 0"),
+            (max(tod, at), f"ALT {acid} {max(wp[-1, 2] / FT_M, 0.1):.2f} {rate_fpm:.3f}"),
+            (max(first_step_s(o.arrival_s, dt_s), at), f"DEL {acid}")]
+    return out
+
+
 def scenario_text(folder: ScheduleFolder, zone_m: tuple[float, float], *, dt_s: float = DEFAULT_DT_S,
                   bank_deg: float = DEFAULT_BANK_DEG, flights: Sequence | None = None,
                   trajectory: str = DEFAULT_TRAJECTORY, designs: dict[str, Trajectory] | None = None) -> str:
@@ -190,12 +247,20 @@ def scenario_text(folder: ScheduleFolder, zone_m: tuple[float, float], *, dt_s: 
     setup = ["CASMACHTHR 0", f"DT {dt_s:g}", "CDMETHOD STATEBASED", "RESO OFF",
              f"ZONER {rpz / NM_M:.6f}", f"ZONEDH {hpz / FT_M:.4f}", f"PAN {float(lat0):.6f} {float(lon0):.6f}"]
     lines = [_stamp(0.0) + c for c in setup]
+    timed: list[tuple[float, int, str]] = []  # vertical flights' commands at their clock times, sorted below
     for o in chosen:
+        if o.flight.vertical_rate_mps is not None:
+            for when, cmd in vertical_commands(ids[o.flight.id], o, designs[o.flight.id], frame, bank_deg, dt_s):
+                timed.append((when, len(timed), cmd))
+            continue
         t_k = first_step_s(o.departure_s, dt_s)
         rest = designs[o.flight.id].rest_from(t_k - o.departure_s)  # created at t_k where the trajectory is then
         clock = Trajectory(rest.times_s + o.departure_s, rest.points, rest.max_error_m)
-        stamp = _stamp(t_k - dt_s / 2)  # executes at the step whose clock reads t_k
-        lines += [stamp + c for c in flight_commands(ids[o.flight.id], clock, frame, bank_deg)]
+        base = len(timed)
+        timed += [(t_k, base + k, c) for k, c in enumerate(flight_commands(ids[o.flight.id], clock, frame, bank_deg))]
+    # BlueSky reads a scenario in file order: every command in clock order (ties in the order written);
+    # a stamp half a step early executes at the step whose clock reads the time
+    lines += [_stamp(when - dt_s / 2) + c for when, _, c in sorted(timed)]
     return "\n".join(head + lines) + "\n"
 
 

@@ -2,7 +2,9 @@
 
 Everything is in the local frame (metres): BlueSky's latitudes and longitudes go back through the
 folder's :class:`~uamopt.export.frame.LocalFrame`, its altitudes are z. The plan of a flight at
-time t is the point its track reaches at distance v_g·(t − departure) (constant speed, Eq. 31).
+time t is the point its track reaches at distance v_g·(t − departure) (constant speed, Eq. 31);
+with vertical phases (the vertiport variant) the first and last segments at the flight's vertical
+rate (:func:`uamopt.schedule.flights.waypoint_times_s`).
 """
 
 from __future__ import annotations
@@ -12,12 +14,15 @@ import itertools
 import numpy as np
 
 
-def planned_positions(waypoints: np.ndarray, speed_mps: float, departure_s: float, t: np.ndarray) -> np.ndarray:
-    """Planned positions (n, 3) at times ``t``: distance v_g(t − dep) along the track, clipped to it."""
-    seg = np.linalg.norm(np.diff(waypoints, axis=0), axis=1)
-    cum = np.concatenate([[0.0], np.cumsum(seg)])
-    s = np.clip(speed_mps * (np.asarray(t, float) - departure_s), 0.0, cum[-1])
-    return np.column_stack([np.interp(s, cum, waypoints[:, a]) for a in range(3)])
+def planned_positions(waypoints: np.ndarray, speed_mps: float, departure_s: float, t: np.ndarray,
+                      vertical_rate_mps: float | None = None) -> np.ndarray:
+    """Planned positions (n, 3) at times ``t``: each waypoint at its planned time from the departure
+    (v_g; the vertical phases at ``vertical_rate_mps``), linear in time between, clipped to the track."""
+    from uamopt.schedule.flights import waypoint_times_s
+
+    times = departure_s + waypoint_times_s(waypoints, speed_mps, vertical_rate_mps)
+    tt = np.clip(np.asarray(t, float), times[0], times[-1])
+    return np.column_stack([np.interp(tt, times, waypoints[:, a]) for a in range(3)])
 
 
 def distance_to_track(points: np.ndarray, waypoints: np.ndarray, chunk: int = 4096) -> np.ndarray:
@@ -36,16 +41,18 @@ def flight_deviation(operated, t: np.ndarray, xyz: np.ndarray) -> dict:
     """Deviations of one flown flight from its plan.
 
     ``t`` (n,) and ``xyz`` (n, 3): the recorded samples of its aircraft. The flown arrival is the
-    last sample's time plus its remaining distance to the last waypoint (along the last leg) / v_g.
+    last sample's time plus its remaining distance to the last waypoint (along the last leg) / v_g
+    (/ the vertical rate for a vertical landing).
     """
     f = operated.flight
     wp = np.asarray(f.waypoints, float)
-    plan = planned_positions(wp, f.speed_mps, operated.departure_s, t)
+    rate = f.vertical_rate_mps
+    plan = planned_positions(wp, f.speed_mps, operated.departure_s, t, rate)
     err_h = np.linalg.norm((xyz - plan)[:, :2], axis=1)
     err_v = np.abs(xyz[:, 2] - plan[:, 2])
     leg = wp[-1] - wp[-2]
     remaining = float(np.dot(wp[-1] - xyz[-1], leg) / np.linalg.norm(leg))
-    arrival = float(t[-1]) + remaining / f.speed_mps
+    arrival = float(t[-1]) + remaining / (f.speed_mps if rate is None else rate)
     k = int(np.argmax(err_h))
     return {
         "flight": f.id, "aircraft": f.aircraft, "route": f.route, "departure_s": operated.departure_s,

@@ -12,7 +12,9 @@ flew with our plan:
 - per flight: largest cross-track distance to the track, largest horizontal and vertical error
   against the planned position at the same time, and the arrival-time deviation; beside them the
   commanded trajectory's own largest distance to the plan (``designed_error_m``, the part no
-  aircraft at this bank limit can avoid) and its speed range.
+  aircraft at this bank limit can avoid) and its speed range; with vertical phases also
+  ``transition_error_m``, v²/(8a), what BlueSky's rotorcraft acceleration costs at the top of
+  climb and of descent (:mod:`uamopt.export.bluesky`).
 
 Results: ``DIR/replay.json`` and the figure ``DIR/replay.png`` (docs/export.md). BlueSky is an
 optional dependency (``pip install 'uamopt[sim]'``).
@@ -39,6 +41,7 @@ from uamopt.export.bluesky import (
     DEFAULT_TRAJECTORY,
     flight_trajectories,
     scenario_text,
+    transition_error_m,
 )
 from uamopt.export.folder import ScheduleFolder, read_schedule_folder
 from uamopt.sim.analysis import flight_deviation, pair_separations
@@ -195,9 +198,12 @@ def _replay(folder: ScheduleFolder, bar, started: float, *, dt_s, bank_deg, budg
     bar.update(1)
     bar.set_description("comparing with the plan")
     result = _compare(folder, chosen, zone, meta, raw)
+    by_id = {o.flight.id: o.flight for o in chosen}
     for f in result[2]:
         design = designs[f["flight"]]
         f["designed_error_m"], f["commanded_speed_mps"] = design.max_error_m, list(design.speed_range_mps)
+        vertical = by_id[f["flight"]].vertical_rate_mps is not None  # hover <-> cruise (export.bluesky)
+        f["transition_error_m"] = transition_error_m(by_id[f["flight"]].speed_mps) if vertical else 0.0
     settings = {"bluesky": meta["bluesky"], "aircraft_type": "EC35", "bank_deg": bank_deg, "dt_s": meta["dt_s"],
                 "trajectory": trajectory,
                 "cd_method": meta["cd_method"], "bluesky_zone_m": meta["zone_m"], "window_s": window_s,
