@@ -60,6 +60,10 @@ class Decoder:
     t_ptr: np.ndarray  # (n + 1,) turnaround rows of each position (families/turnaround.py)
     t_from: np.ndarray  # (R,) the earlier-placed flight e of each row
     t_gap: np.ndarray  # (R,) dep_f ≥ dep_e + t_gap when both operate, s
+    #: the ``cumulative`` shape (families/pads.py, more than one pad): per flight index its holds
+    #: (resource, offset from departure, duration), and each resource's capacity
+    holds: tuple = ()
+    capacity: tuple = ()
 
     @classmethod
     def from_problem(cls, problem: SchedulingProblem, order: np.ndarray | None = None) -> Decoder:
@@ -89,10 +93,20 @@ class Decoder:
         forward = pos[t.e] < pos[t.f]  # a row binds the later-placed flight (chains follow the order)
         t_rows = np.flatnonzero(forward)[np.argsort(pos[t.f[forward]], kind="stable")]
         t_counts = np.bincount(pos[t.f[t_rows]], minlength=n)
+        holds: list[list[tuple[int, float, float]]] = [[] for _ in range(n)]
+        capacity: list[int] = []
+        for family in problem.of_shape("cumulative"):  # one-pad resources are pairs already (problem.pairs)
+            rest = family.residual()
+            base = len(capacity)
+            capacity += [int(c) for c in rest.capacity]
+            for f_, r, o_, l_ in zip(rest.flight.tolist(), rest.resource.tolist(), rest.offset_s.tolist(),
+                                     rest.duration_s.tolist()):
+                holds[f_].append((base + r, o_, l_))
         return cls(order=order, ptr=np.concatenate([[0], np.cumsum(counts)]).astype(np.int64),
                    partner=partner[rows], lo=rel_lo[rows], hi=rel_hi[rows],
                    t_ptr=np.concatenate([[0], np.cumsum(t_counts)]).astype(np.int64), t_from=t.e[t_rows],
-                   t_gap=t.gap_s(problem)[t_rows])
+                   t_gap=t.gap_s(problem)[t_rows], holds=tuple(tuple(h) for h in holds) if capacity else (),
+                   capacity=tuple(capacity))
 
     def decode(self, problem: SchedulingProblem, genes: np.ndarray, step_s: float = DEFAULT_STEP_S,
                exact_gaps: bool = False) -> tuple[np.ndarray, np.ndarray]:
@@ -128,6 +142,35 @@ class Decoder:
         def snap(d: np.ndarray) -> np.ndarray:  # round a delay up to the ΔT_a grid
             return d if exact_gaps else np.ceil(d / step_s - EPS_S / step_s) * step_s
 
+        # cumulative resources: the placed holds of each individual, (P, m) starts and ends (inf: none)
+        placed_s = [np.zeros((size, 0)) for _ in self.capacity]
+        placed_e = [np.zeros((size, 0)) for _ in self.capacity]
+
+        def pad_push(f: int, d: np.ndarray, live: np.ndarray) -> np.ndarray:
+            """The least delay ≥ d (per individual, -inf where none is needed) at which no hold of f
+            would push a resource over its capacity at the instant t* of the first overflow:
+            the earliest end among the holds active at t* (no start before it can fit)."""
+            need = np.full(size, -np.inf)
+            for r, o_, l_ in self.holds[f]:
+                hs, he = placed_s[r], placed_e[r]
+                if hs.shape[1] < self.capacity[r]:
+                    continue
+                s0 = dep0[f] + d + o_
+                e0 = s0 + l_
+                # the load is largest at the hold's start or at a placed start inside the hold
+                t = np.concatenate([s0[:, None], np.where((hs > s0[:, None]) & (hs < e0[:, None] - EPS_S), hs, np.inf)],
+                                   axis=1)  # (P, m + 1)
+                on = (hs[:, None, :] < t[:, :, None] + EPS_S) & (t[:, :, None] < he[:, None, :] - EPS_S)  # (P, T, m)
+                over = (on.sum(axis=2) >= self.capacity[r]) & np.isfinite(t)
+                hit = over.any(axis=1) & live
+                if not hit.any():
+                    continue
+                t_first = np.where(over, t, np.inf).min(axis=1)  # the earliest instant over capacity
+                at = (hs[:, None, :] < t_first[:, None, None] + EPS_S) & (t_first[:, None, None] < he[:, None, :] - EPS_S)
+                end = np.where(at[:, 0, :], he, np.inf).min(axis=1)
+                need = np.where(hit, np.maximum(need, end - dep0[f] - o_), need)
+            return need
+
         for i, f in enumerate(self.order):
             cap = upper[f] + EPS_S
             want = genes[:, f]
@@ -141,26 +184,37 @@ class Decoder:
                 ready = np.where(operated[:, e], dep[:, e] + self.t_gap[ta:tb], -np.inf).max(axis=1)
             d = snap(np.maximum(np.maximum(want, 0) * step_s, ready - dep0[f]))
             a, b = self.ptr[i], self.ptr[i + 1]
-            if b > a:
+            padded = bool(self.holds) and bool(self.holds[f])
+            if b > a or padded:
                 others = self.partner[a:b]
                 live = operated[:, others]  # only operated partners constrain
                 lo = dep[:, others] + self.lo[a:b]
                 hi = dep[:, others] + self.hi[a:b]
-                for _ in range(b - a + 1):  # each pass leaves at least one interval behind for good
+                passes = b - a + 1 + (sum(m.shape[1] for m in placed_e) + 1 if padded else 0)
+                for _ in range(passes):  # each pass leaves at least one interval (or one hold's end) behind for good
+                    trying = on & (d <= cap)
                     inside = live & (lo + EPS_S < d[:, None]) & (d[:, None] < hi - EPS_S)
-                    inside &= (on & (d <= cap))[:, None]
-                    hit = inside.any(axis=1)
+                    inside &= trying[:, None]
+                    push = np.where(inside, hi, -np.inf).max(axis=1) if b > a else np.full(size, -np.inf)
+                    if padded:
+                        push = np.maximum(push, pad_push(int(f), d, trying))
+                    hit = push > d
                     if not hit.any():
                         break
-                    d = np.where(hit, snap(np.where(inside, hi, -np.inf).max(axis=1)), d)
+                    d = np.where(hit, snap(np.maximum(push, d)), d)
             on &= d <= cap
             operated[:, f] = on
             delay[:, f] = np.where(on, np.minimum(d, upper[f]), 0.0)
             dep[:, f] = dep0[f] + delay[:, f]
+            if padded:
+                for r, o_, l_ in self.holds[f]:
+                    start_ = np.where(on, dep[:, f] + o_, np.inf)
+                    placed_s[r] = np.column_stack([placed_s[r], start_])
+                    placed_e[r] = np.column_stack([placed_e[r], np.where(on, start_ + l_, np.inf)])
         return operated, delay
 
 
-SHAPES = frozenset({"bounds", "must_operate", "precedence", "turnaround", "pairs"})  # the decoder's view (from_problem)
+SHAPES = frozenset({"bounds", "must_operate", "precedence", "turnaround", "pairs", "cumulative"})  # the decoder's view (from_problem)
 OBJECTIVES = frozenset({"weighted", "lexicographic", "earliness_tardiness"})
 
 _DECODERS: weakref.WeakKeyDictionary[SchedulingProblem, Decoder] = weakref.WeakKeyDictionary()

@@ -15,6 +15,12 @@ Binary x_{f,k} = 1: flight f operates with delay index k ∈ {0, …, K_f}, K_f 
   forbidden open intervals (lo, hi) of δ = dep_q − dep_p, read from ``problem.pairs``) and
   (ii) every ordered pair e before f of one aircraft (turnaround, Eqs. 27-28: dep_f − dep_e ≥
   A_ef = T_e + ΔT_e with both operated; the all-pairs form is exact, model.py);
+- capacity rows (shape ``cumulative``: more than one pad, families/pads.py) a hold of event e with
+  index k is the interval [D_f + k s + o_e, D_f + k s + o_e + l_e); for every maximal set of such
+  intervals at one resource that share an instant (a maximal clique of the interval graph, found
+  by one sweep) holding more than C flights, Σ x_{f,k} ≤ C. Exact on the grid: the load is largest at some hold's start, which
+  lies in a maximal clique. ``relaxed``: only the part of a hold every delay of its cell covers,
+  [D_f + (k+1) s + o_e, D_f + k s + o_e + l_e), enters the rows (a relaxation);
 - objective     Σ_{f,k} (w_d · k s − w_c) x_{f,k}: Eq. 20 (w_d = ω6/G, w_c = ω7) or the
   lexicographic scalar (w_d = 1/(ΣU + 1), w_c = 1).
 
@@ -73,7 +79,7 @@ from uamopt.schedule.model import Schedule, SchedulingProblem, make_schedule
 from uamopt.solvers.deadline import highs_can_start, interrupt_at, quiet_highs
 from uamopt.solvers.warmstart import Start, no_schedule, no_worse, reduced, warm_start
 
-SHAPES = frozenset({"bounds", "must_operate", "precedence", "turnaround", "pairs"})  # encoded in build_grid_model
+SHAPES = frozenset({"bounds", "must_operate", "precedence", "turnaround", "pairs", "cumulative"})  # build_grid_model
 OBJECTIVES = frozenset({"weighted", "lexicographic", "earliness_tardiness"})
 ETA_S = 1e-9  # float round-off accepted when rounding a time to grid steps, s
 AUTO_HIGHS_COLUMNS = 8000  # engine "auto": HiGHS up to this many columns, "hybrid" above
@@ -92,6 +98,10 @@ class GridModel:
     row_col: np.ndarray
     prec: list  # [(f, group)]: Σ x_f ≤ Σ_{r ∈ group} Σ x_r (families/turnaround.py Precedence)
     must: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))  # flights with Σ x_f = 1 (core.py)
+    #: capacity rows Σ x ≤ cap_rhs (shape cumulative): CSR over columns
+    cap_ptr: np.ndarray = field(default_factory=lambda: np.zeros(1, np.int64))
+    cap_col: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
+    cap_rhs: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     @property
     def n_cols(self) -> int:
@@ -99,7 +109,7 @@ class GridModel:
 
     @property
     def n_rows(self) -> int:
-        return len(self.row_ptr) - 1 + len(self.prec) + len(self.must)
+        return len(self.row_ptr) - 1 + len(self.prec) + len(self.must) + len(self.cap_rhs)
 
     def columns_of(self, operated: np.ndarray, delay_s: np.ndarray) -> np.ndarray | None:
         """The 0-1 vector of a schedule whose delays are on the grid, or None if one is not."""
@@ -144,6 +154,55 @@ def _forbidden_steps(problem: SchedulingProblem, step_s: float, kind: str, k_max
     z_hi = np.minimum(z_hi, k_max[q]).astype(np.int64) if len(p) else z_hi.astype(np.int64)
     keep = z_lo <= z_hi
     return p[keep], q[keep], z_lo[keep], z_hi[keep]
+
+
+def _capacity_rows(problem: SchedulingProblem, step_s: float, kind: str, k_max: np.ndarray, start: np.ndarray):
+    """(ptr, cols, rhs) of the capacity rows of the module docstring: one per maximal clique of
+    each cumulative resource's hold intervals that holds more flights than the capacity."""
+    ptr, cols, rhs = [0], [], []
+    dep = problem.planned_departure_s
+    for family in problem.of_shape("cumulative"):
+        rest = family.residual()
+        for r, cap in enumerate(rest.capacity.tolist()):
+            ev = np.flatnonzero(rest.resource == r)
+            if not len(ev):
+                continue
+            f = rest.flight[ev]
+            count = k_max[f] + 1
+            rep = np.repeat(np.arange(len(ev)), count)
+            k = np.arange(count.sum()) - np.repeat(np.cumsum(count) - count, count)
+            base = dep[f[rep]] + rest.offset_s[ev[rep]]
+            length = rest.duration_s[ev[rep]]
+            if kind == "grid":
+                a, b = base + k * step_s, base + k * step_s + length
+            else:  # the part of the hold every delay of the cell [k s, (k+1) s) covers
+                a, b = base + (k + 1) * step_s, base + k * step_s + length
+            b = b - ETA_S * np.maximum(1.0, np.abs(b))  # an end at a start's instant: apart (half-open)
+            col = start[f[rep]] + k
+            keep = b > a
+            a, b, col = a[keep], b[keep], col[keep]
+            flight_of = f[rep][keep]  # a row binds only where more flights than pads meet
+            if len(col) <= cap:
+                continue
+            # sweep: ends before starts at one instant; a start followed by an end closes a maximal clique
+            times = np.concatenate([a, b])
+            kinds = np.concatenate([np.ones(len(a), np.int8), np.zeros(len(b), np.int8)])
+            which = np.concatenate([np.arange(len(a)), np.arange(len(b))])
+            active: dict[int, None] = {}
+            grew = False
+            for j in np.lexsort((kinds, times)).tolist():
+                if kinds[j]:
+                    active[int(which[j])] = None
+                    grew = True
+                    continue
+                if grew and len(active) > cap and len(set(flight_of[list(active)].tolist())) > cap:
+                    cols.append(col[list(active)])
+                    ptr.append(ptr[-1] + len(active))
+                    rhs.append(float(cap))
+                grew = False
+                active.pop(int(which[j]), None)
+    cols_all = np.concatenate(cols).astype(np.int64) if cols else np.zeros(0, np.int64)
+    return np.asarray(ptr, dtype=np.int64), cols_all, np.asarray(rhs, dtype=float)
 
 
 def build_grid_model(problem: SchedulingProblem, step_s: float = 10.0, kind: str = "grid", both_ways: bool = False
@@ -197,8 +256,10 @@ def build_grid_model(problem: SchedulingProblem, step_s: float = 10.0, kind: str
     row_ptr = np.concatenate([assign_ptr, assign_ptr[-1] + pair_ptr[1:]])
     row_col = np.concatenate([assign_cols, col]).astype(np.int64)
     prec = [(f, group) for family in problem.of_shape("precedence") for f, group in family.groups()]
+    cap_ptr, cap_col, cap_rhs = _capacity_rows(problem, step_s, kind, k_max, start)
     return GridModel(step_s=float(step_s), kind=kind, start=start, cost=cost, row_ptr=row_ptr, row_col=row_col, prec=prec,
-                     must=np.flatnonzero(problem.must_operate).astype(np.int64))
+                     must=np.flatnonzero(problem.must_operate).astype(np.int64), cap_ptr=cap_ptr, cap_col=cap_col,
+                     cap_rhs=cap_rhs)
 
 
 def model_name(kind: str, step_s: float) -> str:
@@ -262,6 +323,10 @@ def _highs(model: GridModel, deadline: float, threads: int, seed: int, gap: floa
         ptr = np.concatenate([[0], np.cumsum([len(c) for c in spans])[:-1]]).astype(np.int32)
         cols = np.concatenate(spans).astype(np.int32)
         h.addRows(len(spans), np.ones(len(spans)), np.full(len(spans), inf), len(cols), ptr, cols, np.ones(len(cols)))
+    if len(model.cap_rhs):  # Σ x ≤ C: capacity
+        c = len(model.cap_rhs)
+        h.addRows(c, np.full(c, -inf), model.cap_rhs, len(model.cap_col), model.cap_ptr[:-1].astype(np.int32),
+                  model.cap_col.astype(np.int32), np.ones(len(model.cap_col)))
     if hint is not None:
         h.setSolution(_solution(highspy, hint))
     h.setOptionValue("time_limit", _left(deadline))  # what the model's loading left of the limit
@@ -315,6 +380,8 @@ def _cpsat(model: GridModel, problem: SchedulingProblem, deadline: float, thread
         m.add(sum(x[model.start[f]:model.start[f + 1]]) <= sum(x[j] for r in group.tolist() for j in range(model.start[r], model.start[r + 1])))
     for f in model.must.tolist():
         m.add_exactly_one(x[model.start[f]:model.start[f + 1]])
+    for r, cap in enumerate(model.cap_rhs.tolist()):
+        m.add(sum(x[j] for j in model.cap_col[model.cap_ptr[r]:model.cap_ptr[r + 1]].tolist()) <= int(cap))
     k_of_col = np.arange(model.n_cols) - np.repeat(model.start[:-1], k_max + 1)
     if problem.objective.per_flight_terms:  # earliness/tardiness in integers (cpsat.integer_terms)
         from uamopt.solvers.cpsat import integer_terms
@@ -416,7 +483,7 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
               "engine_first_incumbent_s": result.first_incumbent_s, "engine_best_incumbent_s": result.best_incumbent_s,
               "engine_seconds": round(result.seconds, 3)}
     n = problem.n_flights
-    if result.x is None and "infeasible" in result.termination.lower():
+    if result.x is None and "infeasible" in result.termination.lower() and not len(model.cap_rhs):
         # infeasible on the grid, a restriction: the continuous MILP (milp.py) decides, in the time left
         import dataclasses
 
