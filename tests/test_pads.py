@@ -120,16 +120,24 @@ def test_more_pads_need_the_cumulative_shape(small):
     assert two.objective <= one.objective + 1e-9  # a second pad never hurts
 
 
-def test_cumulative_agrees_with_the_brute_force(network):
-    """Two pads on a tiny instance: the brute force (branching on every three holds) and CP-SAT's
-    AddCumulative find the same optimum (CP-SAT's covers holds by whole 0.01 s units: at most
-    that per flight worse)."""
+@pytest.fixture(scope="module")
+def tiny_two_pads(network):
+    """Three aircraft, one flight each from V1 to V5 at once, with vertical phases: without pads,
+    with two, and the brute force's optimum with two."""
     lex = ["network.routes=[[\"V1\",\"V5\"]]"]
     scenario, flights = plan(network, ON + lex + ["schedule.aircraft=3",
                                             "schedule.flights=3", "schedule.first_departure_window_s=0.0"])
     free = build_problem(flights, scenario, objective="lexicographic")
     two = build_problem(flights, load_scenario(PAPER_CASE, ON + lex + ["network.pads=2"]), objective="lexicographic")
-    exact = bruteforce.solve(two)
+    return free, two, bruteforce.solve(two)
+
+
+def test_cumulative_agrees_with_the_brute_force(tiny_two_pads):
+    """Two pads on a tiny instance: the brute force (branching on every three holds) and CP-SAT's
+    AddCumulative find the same optimum (CP-SAT's covers holds by whole 0.01 s units: at most
+    that per flight worse)."""
+    free, two, exact = tiny_two_pads
+    flights = two.flights
     assert exact.status == "optimal"
     assert exact.objective > bruteforce.solve(free).objective + 1e-9  # two pads bind here
     cp = ua.solve(two, "cpsat", time_limit_s=30)
@@ -256,17 +264,13 @@ def test_the_heuristics_keep_two_pads(network):
         assert ua.verify(two, s).ok, solver
 
 
-def test_timeindexed_capacity_rows_bracket_the_brute_force(network):
+def test_timeindexed_capacity_rows_bracket_the_brute_force(tiny_two_pads):
     """Two pads on the tiny instance of test_cumulative_agrees_with_the_brute_force, where they
     bind: the time-indexed grid model (a restriction, 1 s steps) keeps two pads and is never better
     than the brute force's continuous optimum; its relaxed model (1 s cells) bounds that optimum
     from below; and the grid optimum is worse than without pads (the rows act)."""
-    lex = ["network.routes=[[\"V1\",\"V5\"]]"]
-    scenario, flights = plan(network, ON + lex + ["schedule.aircraft=3",
-                                            "schedule.flights=3", "schedule.first_departure_window_s=0.0"])
-    free = build_problem(flights, scenario, objective="lexicographic")
-    two = build_problem(flights, load_scenario(PAPER_CASE, ON + lex + ["network.pads=2"]), objective="lexicographic")
-    exact = bruteforce.solve(two)
+    free, two, exact = tiny_two_pads
+    flights = two.flights
     grid = ua.solve(two, ua.SolverProfile("timeindexed", time_limit_s=30, options={"step_s": 1.0}))
     relaxed = ua.solve(two, ua.SolverProfile("timeindexed", time_limit_s=30, options={"step_s": 1.0, "model": "relaxed"}))
     unpadded = ua.solve(free, ua.SolverProfile("timeindexed", time_limit_s=30, options={"step_s": 1.0}))
