@@ -19,6 +19,14 @@ Variables
     Σ_j y_j ≥ c_p + c_q − 1, and y_j = 1 ⇒ g_j ≤ δ ≤ h_j with M = g_j − min R and max R − h_j (the
     bound is dropped where M = 0). A pair with one gap needs no y (y = c_p + c_q − 1 is implied);
     a pair with none cannot fly both: c_p + c_q ≤ 1.
+(d) pads         (shape ``cumulative``, more than C = 1 pad; families/pads.py): for each pair of holds
+    a, b at one resource that can meet (:meth:`Pads.meetings`), binaries β_ab (a ends before b
+    starts) and α_ab (b ends before a starts), β + α ≤ 1, each forcing its order with a tight big-M
+    relaxed where either flight is cancelled; and for every set S of C + 1 holds that can all meet
+    pairwise, Σ_{pairs of S} (β + α) ≥ 1: some two of them are apart. Exact, with no tie rule: if
+    no C + 1 holds overlap pairwise, no instant holds C + 1 (intervals on a line, Helly), and a
+    schedule within capacity sets β, α from its own order. The sets are enumerated (networkx
+    cliques of the meeting graph); a problem needing more than ``MAX_PAD_SETS`` refuses in one line.
 Objective (Eqs. 20-22) ``weighted``: W = ω6 Σ d_f / G − ω7 Σ c_f; ``lexicographic``:
     −Σ c_f + Σ d_f / (Σ U_f + 1) (model.py).
 
@@ -134,6 +142,63 @@ def define_conflicts(m: pyo.ConcreteModel, problem: SchedulingProblem, family=No
     m.gap_below = pyo.Constraint(both, rule=below)
 
 
+MAX_PAD_SETS = 200_000  # (C + 1)-sets of holds that can meet: beyond this the pads rows refuse (use cpsat)
+
+
+def define_cumulative(m: pyo.ConcreteModel, problem: SchedulingProblem, family) -> None:
+    """(d) the pads of more than one (``family.residual()``); one-pad resources are rows of
+    ``problem.pairs`` (define_conflicts)."""
+    import itertools
+
+    import networkx as nx
+
+    res = family.residual()
+    dep, upper = problem.planned_departure_s, problem.delay_upper_s
+    a, b = res.meetings(np.arange(len(res.flight)), dep, upper)
+    fa, fb = res.flight[a], res.flight[b]
+    oa, la, ob, lb = res.offset_s[a], res.duration_s[a], res.offset_s[b], res.duration_s[b]
+    # start_b − start_a = dep_fb − dep_fa + o_b − o_a, over d ∈ [0, U]: its least and largest values
+    shift = dep[fb] - dep[fa] + ob - oa
+    big_before = np.maximum(0.0, la - (shift - upper[fa]))  # a before b: start_b − start_a ≥ l_a
+    big_after = np.maximum(0.0, lb + (shift + upper[fb]))  # b before a: start_a − start_b ≥ l_b
+    pairs = list(range(len(a)))
+    rows = [(int(fa[k]), int(fb[k]), float(oa[k]), float(la[k]), float(ob[k]), float(lb[k]),
+             float(big_before[k]), float(big_after[k])) for k in pairs]
+    sets = []
+    for r, cap in enumerate(res.capacity.tolist()):
+        graph = nx.Graph()
+        graph.add_edges_from((int(a[k]), int(b[k]), {"k": k}) for k in pairs if res.resource[a[k]] == r)
+        for clique in nx.enumerate_all_cliques(graph):
+            if len(clique) > cap + 1:
+                break
+            if len(clique) == cap + 1:
+                sets.append([graph.edges[u, v]["k"] for u, v in itertools.combinations(clique, 2)])
+                if len(sets) > MAX_PAD_SETS:
+                    raise UamoptError(f"the pads need more than {MAX_PAD_SETS:,} rows of {cap + 1} holds that can meet "
+                                      f"at {res.resources[r]}", "solver highs (family pads)",
+                                      "use cpsat (AddCumulative) for this many pads, or fewer flights")
+    m.pad_rows = rows
+    m.pad_pairs = pyo.RangeSet(0, len(rows) - 1) if rows else pyo.Set(initialize=[])
+    m.pad_before = pyo.Var(m.pad_pairs, within=pyo.Binary)
+    m.pad_after = pyo.Var(m.pad_pairs, within=pyo.Binary)
+    m.pad_one_order = pyo.Constraint(m.pad_pairs, rule=lambda m, k: m.pad_before[k] + m.pad_after[k] <= 1)
+
+    def gap(m, k):  # start_b − start_a
+        f, g, o_a, _, o_b = m.pad_rows[k][:5]
+        return m.delay[g] - m.delay[f] + float(dep[g] - dep[f] + o_b - o_a)
+
+    def off(m, k):  # 2 − c_fa − c_fb
+        return 2 - m.operate[m.pad_rows[k][0]] - m.operate[m.pad_rows[k][1]]
+
+    m.pad_order_before = pyo.Constraint(m.pad_pairs, rule=lambda m, k: gap(m, k) >= m.pad_rows[k][3]
+                                        - m.pad_rows[k][6] * (1 - m.pad_before[k] + off(m, k)))
+    m.pad_order_after = pyo.Constraint(m.pad_pairs, rule=lambda m, k: -gap(m, k) >= m.pad_rows[k][5]
+                                       - m.pad_rows[k][7] * (1 - m.pad_after[k] + off(m, k)))
+    m.pad_sets = sets
+    m.pad_apart = pyo.Constraint(range(len(sets)), rule=lambda m, s: sum(m.pad_before[k] + m.pad_after[k]
+                                                                        for k in m.pad_sets[s]) >= 1)
+
+
 def define_objective(m: pyo.ConcreteModel, problem: SchedulingProblem) -> None:
     """``problem.objective`` (Eqs. 20-22 or the lexicographic scalar), with Σ d_f = Σ c_f d_f by
     d_f ≤ U_f c_f; earliness/tardiness: early_f ≥ a_f c_f − d_f and late_f ≥ d_f − a_f, both ≥ 0
@@ -156,7 +221,7 @@ def define_objective(m: pyo.ConcreteModel, problem: SchedulingProblem) -> None:
 #: one encoder per family shape (uamopt.schedule.families); ``pairs`` and ``turnaround`` encode the
 #: merged view of every family of their shape once
 ENCODERS = {"bounds": define_bounds, "must_operate": define_must_operate, "precedence": define_precedence,
-            "turnaround": define_turnaround, "pairs": define_conflicts}
+            "turnaround": define_turnaround, "pairs": define_conflicts, "cumulative": define_cumulative}
 SHAPES = frozenset(ENCODERS)
 OBJECTIVES = frozenset({"weighted", "lexicographic", "earliness_tardiness"})
 
@@ -169,7 +234,7 @@ def build_model(problem: SchedulingProblem, extra=None) -> pyo.ConcreteModel:
     define_variables(m, problem)
     done = set()
     for family in problem.families:
-        if family.shape == "cumulative":  # one-pad resources only (check_supported): rows of problem.pairs
+        if family.shape == "cumulative" and not len(family.residual().flight):  # one pad: rows of problem.pairs
             continue
         if family.shape in ("pairs", "turnaround"):  # merged views: encoded once
             if family.shape in done:
@@ -184,15 +249,18 @@ def build_model(problem: SchedulingProblem, extra=None) -> pyo.ConcreteModel:
     return m
 
 
-def least_delays(problem: SchedulingProblem, operated: np.ndarray, chosen: dict[int, tuple[float, float]]) -> np.ndarray | None:
+def least_delays(problem: SchedulingProblem, operated: np.ndarray, chosen: dict[int, tuple[float, float]],
+                 orders: list[tuple[int, int, float]] = ()) -> np.ndarray | None:
     """The least delays (minimal Σ d) of the operated flights for fixed gap choices, or None if none fit.
 
-    ``chosen`` maps a pair's row in ``admissible_gaps`` to its gap [g, h]. Bellman-Ford longest
+    ``chosen`` maps a pair's row in ``admissible_gaps`` to its gap [g, h]; ``orders`` adds edges
+    (i, j, w): dep_j ≥ dep_i + w (the pads' chosen orders, :func:`_orders`). Bellman-Ford longest
     path on dep_j ≥ dep_i + w from d = 0; at most n rounds, vectorised over the edges.
     """
     dep, upper, t = problem.planned_departure_s, problem.delay_upper_s, problem.turnaround
     both = operated[t.e] & operated[t.f]
     edges = list(zip(t.e[both].tolist(), t.f[both].tolist(), t.gap_s(problem)[both].tolist()))  # (i, j, w): dep_j ≥ dep_i + w
+    edges += list(orders)
     for k, (low, high) in chosen.items():
         p, q = int(problem.pairs.p[k]), int(problem.pairs.q[k])
         edges += [(p, q, low), (q, p, -high)]  # g ≤ dep_q − dep_p ≤ h
@@ -210,8 +278,8 @@ def least_delays(problem: SchedulingProblem, operated: np.ndarray, chosen: dict[
     return None  # a positive cycle: the choices admit no delays
 
 
-def least_cost_delays(problem: SchedulingProblem, operated: np.ndarray, chosen: dict[int, tuple[float, float]]
-                      ) -> np.ndarray | None:
+def least_cost_delays(problem: SchedulingProblem, operated: np.ndarray, chosen: dict[int, tuple[float, float]],
+                      orders: list[tuple[int, int, float]] = ()) -> np.ndarray | None:
     """The earliness/tardiness objective's optimal delays for fixed gap choices: the LP
     min Σ e_f E_f + l_f L_f over the same difference constraints as :func:`least_delays`
     (scipy's HiGHS, exact to its tolerances), or None if it fails."""
@@ -232,6 +300,7 @@ def least_cost_delays(problem: SchedulingProblem, operated: np.ndarray, chosen: 
         p, q = int(problem.pairs.p[k]), int(problem.pairs.q[k])
         shift = dep[q] - dep[p]
         rows += [(p, q, shift - low), (q, p, high - shift)]
+    rows += [(i, j, float(dep[j] - dep[i] - w)) for i, j, w in orders]  # dep_j ≥ dep_i + w: d_i − d_j ≤ D_j − D_i − w
     m = len(flown)  # variables: d (m), early (m), late (m)
     r_i, r_j, data, b = [], [], [], []
     for r, (i, j, bound) in enumerate(rows):
@@ -267,6 +336,19 @@ def _choices(m: pyo.ConcreteModel, operated: np.ndarray) -> dict[int, tuple[floa
     return chosen
 
 
+def _orders(m: pyo.ConcreteModel, operated: np.ndarray) -> list[tuple[int, int, float]]:
+    """The pads' orders the MILP chose between operated flights, as edges dep_j ≥ dep_i + w."""
+    out = []
+    for k, (f, g, o_a, l_a, o_b, l_b, _, _) in enumerate(getattr(m, "pad_rows", ())):
+        if not (operated[f] and operated[g]):
+            continue
+        if pyo.value(m.pad_before[k]) > 0.5:  # a ends before b starts: dep_g + o_b ≥ dep_f + o_a + l_a
+            out.append((f, g, o_a + l_a - o_b))
+        elif pyo.value(m.pad_after[k]) > 0.5:
+            out.append((g, f, o_b + l_b - o_a))
+    return out
+
+
 def mip_start(m: pyo.ConcreteModel, problem: SchedulingProblem, operated: np.ndarray, delay_s: np.ndarray) -> dict:
     """Values of every variable of ``build_model`` for a feasible schedule (a MIP start), keyed by
     ``id(var)``: c, d, and y = 1 on the admissible gap that holds δ for each operated pair (else 0)."""
@@ -284,6 +366,10 @@ def mip_start(m: pyo.ConcreteModel, problem: SchedulingProblem, operated: np.nda
             pick = min(range(len(gaps)), key=lambda j: max(gaps[j][0] - delta, delta - gaps[j][1], 0.0))
         for j in range(len(gaps)):
             values[id(m.in_gap[k, j])] = float(j == pick)
+    for k, (f, g, o_a, l_a, o_b, l_b, _, _) in enumerate(getattr(m, "pad_rows", ())):
+        apart_before = not (operated[f] and operated[g]) or dep[g] + o_b >= dep[f] + o_a + l_a - TIME_TOL_S
+        apart_after = not apart_before and dep[f] + o_a >= dep[g] + o_b + l_b - TIME_TOL_S
+        values[id(m.pad_before[k])], values[id(m.pad_after[k])] = float(apart_before), float(apart_after)
     return values
 
 
@@ -352,8 +438,9 @@ def solve(problem: SchedulingProblem, profile, extra=None) -> Schedule:
     if has_solution:
         result.solution_loader.load_vars()
         operated = np.array([pyo.value(m.operate[f]) > 0.5 for f in range(n)])
-        polished = (least_delays(problem, operated, _choices(m, operated)) if not problem.objective.per_flight_terms
-                    else least_cost_delays(problem, operated, _choices(m, operated)))
+        chosen, orders = _choices(m, operated), _orders(m, operated)
+        polished = (least_delays(problem, operated, chosen, orders) if not problem.objective.per_flight_terms
+                    else least_cost_delays(problem, operated, chosen, orders))
         if extra is not None and polished is not None:  # rows of the callback the polishing does not know
             polished = None
         extras["polished"] = polished is not None

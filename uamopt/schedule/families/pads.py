@@ -76,38 +76,39 @@ class Pads:
         return replace(self, flight=self.flight[keep], resource=self.resource[keep], offset_s=self.offset_s[keep],
                        duration_s=self.duration_s[keep], landing=self.landing[keep])
 
-    def disjunctive(self, planned_s=None, upper_s=None) -> PairIntervals:
-        """The events at one-pad vertiports as pair intervals: no two may overlap.
-
-        With the planned departures ``planned_s`` and the largest delays ``upper_s``, only the pairs
-        that can meet are kept: event k can only lie in [P + o_k, P + U + o_k + l_k) of its flight,
-        and two events whose windows do not overlap never conflict (a pruning, not a relaxation)."""
+    def meetings(self, events: np.ndarray, planned_s=None, upper_s=None) -> tuple[np.ndarray, np.ndarray]:
+        """Pairs (a, b) of ``events`` (indices, a before b in window order) at one resource that can
+        overlap: event k can only lie in [P + o_k, P + U + o_k + l_k) of its flight (P the planned
+        departure, U the largest delay); two events whose windows do not overlap never meet.
+        Without ``planned_s`` every pair at one resource."""
         blocks = []
-        single = self.capacity[self.resource] == 1
-        for r in np.flatnonzero(self.capacity == 1).tolist():
-            ev = np.flatnonzero(single & (self.resource == r))
+        events = np.asarray(events, dtype=np.int64)
+        for r in np.unique(self.resource[events]).tolist():
+            ev = events[self.resource[events] == r]
             if planned_s is None:
-                lo_w = np.zeros(len(ev))
-                hi_w = np.full(len(ev), np.inf)
+                lo_w, hi_w = np.zeros(len(ev)), np.full(len(ev), np.inf)
             else:
-                base = np.asarray(planned_s, dtype=float)[self.flight[ev]] + self.offset_s[ev]
-                lo_w = base
-                hi_w = base + np.asarray(upper_s, dtype=float)[self.flight[ev]] + self.duration_s[ev]
+                lo_w = np.asarray(planned_s, dtype=float)[self.flight[ev]] + self.offset_s[ev]
+                hi_w = lo_w + np.asarray(upper_s, dtype=float)[self.flight[ev]] + self.duration_s[ev]
             order = np.argsort(lo_w, kind="stable")
             ev, lo_w, hi_w = ev[order], lo_w[order], hi_w[order]
-            # partners of x: the later-sorted events whose window opens before x's closes
-            stop = np.searchsorted(lo_w, hi_w, side="left")
+            stop = np.searchsorted(lo_w, hi_w, side="left")  # partners of x: later windows opening before x's closes
             count = np.maximum(stop - np.arange(len(ev)) - 1, 0)
             a = np.repeat(np.arange(len(ev)), count)
-            if not len(a):
-                continue
             first = np.repeat(np.cumsum(count) - count, count)
             b = a + 1 + (np.arange(len(a)) - first)
-            a, b = ev[a], ev[b]
-            keep = self.flight[a] != self.flight[b]
-            blocks.append((a[keep], b[keep]))
-        a = np.concatenate([x for x, _ in blocks]) if blocks else np.zeros(0, dtype=np.int64)
-        b = np.concatenate([y for _, y in blocks]) if blocks else np.zeros(0, dtype=np.int64)
+            blocks.append((ev[a], ev[b]))
+        if not blocks:
+            return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
+        return np.concatenate([x for x, _ in blocks]), np.concatenate([y for _, y in blocks])
+
+    def disjunctive(self, planned_s=None, upper_s=None) -> PairIntervals:
+        """The events at one-pad vertiports as pair intervals: no two may overlap. With the planned
+        departures and largest delays, only the pairs that can meet (:meth:`meetings`; a pruning,
+        not a relaxation)."""
+        a, b = self.meetings(np.flatnonzero(self.capacity[self.resource] == 1), planned_s, upper_s)
+        keep = self.flight[a] != self.flight[b]
+        a, b = a[keep], b[keep]
         oa, la, ob, lb = self.offset_s[a], self.duration_s[a], self.offset_s[b], self.duration_s[b]
         rows = list(zip(self.flight[a].tolist(), self.flight[b].tolist(), (oa - ob - lb).tolist(), (oa + la - ob).tolist()))
         return PairIntervals.of_rows(self.name, rows, description="vertiport pads (one pad: no two holds overlap)")
