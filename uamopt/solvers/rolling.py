@@ -8,7 +8,8 @@ Flights are sorted by planned departure and the day is cut into windows of ``win
 on a **sub-problem** in which the flights of earlier windows are *fixed* at their decisions:
 
 - every earlier **operated** flight that matters to a free flight — it conflicts with one (a pair
-  of ``problem.conflicts``), or it is the last operated earlier flight of a free flight's aircraft
+  of ``problem.pairs``, or a pad hold that can meet one of the free flight's, family ``pads``),
+  or it is the last operated earlier flight of a free flight's aircraft
   (the turnaround rule of the model is implied by the last operated one) — enters the sub-problem
   as a *fixed* flight: planned departure = its decided departure, delay bound 0 (``max_delay_s
   = 0``), and it **must operate** (``must_operate`` of the sub-problem, uamopt.schedule.core,
@@ -68,9 +69,10 @@ from uamopt.schedule.model import Schedule, SchedulingProblem, make_schedule, vi
 from uamopt.schedule.occupancy import ConflictTable
 from uamopt.solvers.greedy import greedy_decisions
 
-SHAPES = frozenset({"bounds", "must_operate", "precedence", "turnaround", "pairs"})
-#: its sub-problems rebuild the paper's five families from a sub flight set: no other family survives
-FAMILIES = frozenset({"delay_bounds", "must_operate", "precedence", "turnaround", "conflicts"})
+SHAPES = frozenset({"bounds", "must_operate", "precedence", "turnaround", "pairs", "cumulative"})
+#: its sub-problems rebuild the paper's five families from a sub flight set, and carry ``pads``
+#: (families/pads.py, restricted to the window's flights): no other family survives
+FAMILIES = frozenset({"delay_bounds", "must_operate", "precedence", "turnaround", "conflicts", "pads"})
 OBJECTIVES = frozenset({"weighted", "lexicographic"})  # its lower bound needs Σ d (pair_matching_bound)
 
 
@@ -149,9 +151,11 @@ def subproblem(problem: SchedulingProblem, free: np.ndarray, fixed: np.ndarray, 
     table = ConflictTable(p=pos[c.p[keep]], q=pos[c.q[keep]],
                           ptr=np.concatenate([[0], np.cumsum(counts[keep])]).astype(np.int64),
                           intervals=c.intervals[row_keep])
+    pads = tuple(f.restricted(pos) for f in problem.extra_families if f.name == "pads")
     sub = SchedulingProblem(flights=sub_fs, conflicts=table, weights=problem.weights,
                             aircraft_count=problem.aircraft_count, objective_kind=problem.objective_kind,
-                            time_step_s=problem.time_step_s, must_operate=is_fixed[index] | problem.must_operate[index])
+                            time_step_s=problem.time_step_s, must_operate=is_fixed[index] | problem.must_operate[index],
+                            extra_families=pads)
     return sub, index, is_fixed[index]
 
 
@@ -233,7 +237,11 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
     windows = [order[window_of[order] == w] for w in np.unique(window_of)]
     limit = float(o["window_time_limit_s"]) if o["window_time_limit_s"] is not None else profile.time_limit_s / max(len(windows), 1)
     aircraft = problem.flights.aircraft_index
-    pairs = np.stack([problem.pairs.p, problem.pairs.q], axis=1)
+    pairs = np.stack([problem.pairs.p, problem.pairs.q], axis=1)  # one-pad holds included (problem.pairs)
+    for family in problem.of_shape("cumulative"):  # flights whose holds can meet at a resource of more pads
+        rest = family.residual()
+        a, b = rest.meetings(np.arange(len(rest.flight)), dep0, problem.delay_upper_s)
+        pairs = np.concatenate([pairs, np.stack([rest.flight[a], rest.flight[b]], axis=1)])
     decided = np.zeros(n, dtype=bool)
     operated = np.zeros(n, dtype=bool)
     delay = np.zeros(n)

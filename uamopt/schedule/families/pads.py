@@ -113,6 +113,14 @@ class Pads:
         rows = list(zip(self.flight[a].tolist(), self.flight[b].tolist(), (oa - ob - lb).tolist(), (oa + la - ob).tolist()))
         return PairIntervals.of_rows(self.name, rows, description="vertiport pads (one pad: no two holds overlap)")
 
+    def restricted(self, pos: np.ndarray) -> Pads:
+        """The family on a subset of the flights: ``pos[f]`` is flight f's index there, −1 where
+        it is left out (a rolling-horizon window: offsets are from each flight's departure, so they
+        carry over to a flight fixed at its decided departure)."""
+        keep = np.asarray(pos)[self.flight] >= 0
+        out = self._events_at(keep)
+        return replace(out, flight=np.asarray(pos)[out.flight].astype(np.int64))
+
     def residual(self) -> Pads:
         """The events at vertiports with more than one pad (the cumulative part)."""
         return self._events_at(self.capacity[self.resource] > 1)
