@@ -6,7 +6,14 @@ read them as they are:
 
 - ``tracks.geojson``: one LineString per flight with z (m above the ground datum) at every
   waypoint; properties id, aircraft, route, origin, destination, operated, departure_s,
-  arrival_s (null when cancelled), speed_mps, length_m.
+  arrival_s (null when cancelled), speed_mps, length_m. An operated flight's vertices carry their
+  time too, for trip layers (kepler.gl, QGIS's temporal controller): a 4th coordinate, Unix time
+  in seconds rounded to the millisecond ([lon, lat, z, t], kepler.gl's trip-layer form), and the
+  properties ``timestamps`` (s on the schedule's clock, the clock of departure_s, one per vertex:
+  departure + :func:`~uamopt.schedule.flights.waypoint_times_s`) and ``time_origin_utc``. The
+  schedule records no calendar date, so clock 0 s is the fixed :data:`TIME_ORIGIN_UTC`
+  (t = :data:`TIME_ORIGIN_UNIX_S` + clock), also in the collection's ``uamopt`` member. A
+  cancelled flight keeps [lon, lat, z] and has neither property.
 - ``vertiports.geojson``: one Point per vertiport named in the flights (a track's first point is
   its origin, its last point its destination).
 - ``unsafe.geojson``: one (Multi)Polygon per altitude layer, the union of that layer's unsafe
@@ -21,6 +28,7 @@ records (summary.json ``scenario``: file and overrides); ``risk=`` takes a ``ris
 from __future__ import annotations
 
 import json
+from datetime import UTC, datetime
 from pathlib import Path
 
 import numpy as np
@@ -29,22 +37,38 @@ import shapely.geometry
 from shapely.geometry.polygon import orient
 
 from uamopt.errors import InputFileError
-from uamopt.io import read_npz
 from uamopt.export.folder import (
+    OperatedFlight,
     ScheduleFolder,
     read_schedule_folder,
     recorded_scenario,
     write_texts,
 )
+from uamopt.io import read_npz
+from uamopt.schedule.flights import waypoint_times_s
 
 DEGREE_DIGITS = 7  # ~1 cm
 METRE_DIGITS = 2
+#: the UTC instant of the schedule clock's 0 s: a schedule records no calendar date (summary.json,
+#: the scenario and the frame carry none), so the trip layers' Unix times start at a fixed day
+TIME_ORIGIN_UTC = "2026-01-01T00:00:00Z"
+TIME_ORIGIN_UNIX_S = int(datetime(2026, 1, 1, tzinfo=UTC).timestamp())  # 1767225600
+#: decimals of the 4th coordinate (ms): kepler.gl recognises Unix seconds with at most 3 decimals
+UNIX_DIGITS = 3
 
 
-def _collection(features: list[dict], folder: ScheduleFolder, what: str) -> str:
+def _collection(features: list[dict], folder: ScheduleFolder, what: str, extra: dict | None = None) -> str:
     doc = {"type": "FeatureCollection", "name": what, "features": features,
-           "uamopt": {"folder": folder.path.name, "frame": folder.frame.as_dict(), "frame_recorded": folder.frame_recorded}}
+           "uamopt": {"folder": folder.path.name, "frame": folder.frame.as_dict(), "frame_recorded": folder.frame_recorded,
+                      **(extra or {})}}
     return json.dumps(doc, separators=(",", ":")) + "\n"
+
+
+def vertex_times_s(o: OperatedFlight) -> np.ndarray:
+    """Clock time of each waypoint of the operated flight ``o``, s: its departure
+    plus the time to reach the waypoint at ``speed_mps``, the vertical phases at their rate."""
+    f = o.flight
+    return o.departure_s + waypoint_times_s(f.waypoints, f.speed_mps, f.vertical_rate_mps)
 
 
 def _lonlat(frame, xy: np.ndarray) -> np.ndarray:
@@ -53,18 +77,24 @@ def _lonlat(frame, xy: np.ndarray) -> np.ndarray:
 
 
 def track_features(folder: ScheduleFolder) -> list[dict]:
-    """One LineString Z feature per flight of the folder."""
+    """One LineString Z feature per flight of the folder; an operated flight's with the time of
+    every vertex (4th coordinate, Unix s; ``timestamps``, clock s)."""
     times = {o.flight.id: o for o in folder.operated}
     out = []
     for f in folder.flights.flights:
         wp = np.asarray(f.waypoints, float)
         coords = np.column_stack([_lonlat(folder.frame, wp), np.round(wp[:, 2], METRE_DIGITS)])
         o = times.get(f.id)
+        properties = {"id": f.id, "aircraft": f.aircraft, "route": f.route, "origin": f.origin,
+                      "destination": f.destination, "operated": o is not None,
+                      "departure_s": o.departure_s if o else None, "arrival_s": o.arrival_s if o else None,
+                      "speed_mps": f.speed_mps, "length_m": round(f.length_m, METRE_DIGITS)}
+        if o is not None:
+            clock = vertex_times_s(o)
+            coords = np.column_stack([coords, np.round(TIME_ORIGIN_UNIX_S + clock, UNIX_DIGITS)])
+            properties.update(timestamps=clock.tolist(), time_origin_utc=TIME_ORIGIN_UTC)
         out.append({"type": "Feature", "geometry": {"type": "LineString", "coordinates": coords.tolist()},
-                    "properties": {"id": f.id, "aircraft": f.aircraft, "route": f.route, "origin": f.origin,
-                                   "destination": f.destination, "operated": o is not None,
-                                   "departure_s": o.departure_s if o else None, "arrival_s": o.arrival_s if o else None,
-                                   "speed_mps": f.speed_mps, "length_m": round(f.length_m, METRE_DIGITS)}})
+                    "properties": properties})
     return out
 
 
@@ -148,5 +178,6 @@ def export_geojson(path: str | Path, *, risk: str | Path | None = None, scenario
     layers = _unsafe_layers(folder, risk, scenario, overrides)  # before writing anything
     files = {"tracks.geojson": track_features(folder), "vertiports.geojson": vertiport_features(folder),
              "unsafe.geojson": unsafe_features(folder, *layers)}
-    return write_texts(folder.path, {name: _collection(features, folder, name.removesuffix(".geojson"))
+    extra = {"tracks.geojson": {"time_origin_utc": TIME_ORIGIN_UTC, "time_origin_unix_s": TIME_ORIGIN_UNIX_S}}
+    return write_texts(folder.path, {name: _collection(features, folder, name.removesuffix(".geojson"), extra.get(name))
                                      for name, features in files.items()})
