@@ -7,6 +7,7 @@ from __future__ import annotations
 import csv
 import dataclasses
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -122,3 +123,21 @@ def test_on_the_paper_case_speed_options_are_never_worse(paper_straight_plan):
     fast = ua.solve(problem, "highs", time_limit_s=300)
     assert ua.verify(problem, fast).ok
     assert (-fast.operated_count, fast.total_delay_s) <= (-cruise.operated_count, cruise.total_delay_s + 1e-6)
+
+
+def test_the_schedule_command_counts_flights_not_speed_copies(tmp_path, capsys):
+    """``uamopt schedule`` with two speed options prints the counts of schedule.csv (one row per
+    flight), not of the model's copies (two per flight): 12 flights, operated + cancelled = 12."""
+    import csv
+
+    folder = tmp_path / "two_speeds"
+    root = Path(__file__).resolve().parents[1]
+    assert main(["schedule", str(root / "models" / "paper_case.toml"), "--solver", "greedy", "--out", str(folder),
+                 "--set", 'network.tracks="straight"', "--set", "schedule.aircraft=4", "--set", "schedule.flights=12",
+                 "--set", "schedule.speed_options=[0.8, 1.0]"]) == 0
+    line = capsys.readouterr().out.strip().splitlines()[-1]
+    with open(folder / "schedule.csv", newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    flown = sum(r["operated"] == "1" for r in rows)
+    assert len(rows) == 12
+    assert f"operated {flown}, cancelled {12 - flown}," in line, line

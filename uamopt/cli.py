@@ -92,6 +92,10 @@ def cmd_schedule(args) -> int:
     scenario = _load(args)
     profile = load_profile(args.solver)
     problem, s, problems = schedule_folder(scenario, args.out, profile, args.flights, args.network, args.seed, args.set)
+    from uamopt.schedule.families.speed import collapse, speed_choice_of
+
+    if speed_choice_of(problem) is not None:  # one row per flight, as schedule.csv (not one per speed copy)
+        problem, s = collapse(problem, s)
     print(f"{s.solver}: {s.status}, {problem.objective_kind} objective {s.objective}, operated {s.operated_count}, cancelled {s.cancelled}, "
           f"total delay {s.total_delay_s:.1f} s, {s.solve_seconds:.2f} s -> {Path(args.out) / 'schedule.csv'}")
     if problems:  # a solver bug, never bad input: say so loudly
