@@ -12,8 +12,22 @@ $(VENV)/.base: pyproject.toml
 	$(PY) -m pip install --quiet -e .
 	touch $@
 
-$(VENV)/.dev: $(VENV)/.base
+$(VENV)/.dev: $(VENV)/.base $(VENV)/.browser
 	$(PY) -m pip install --quiet -e '.[dev]'
+	touch $@
+
+# A real browser for tests/test_view_browser.py: Debian's chromium and chromium-driver, installed with
+# apt-get when missing (CI runs as root); elsewhere the test is skipped and says why.
+$(VENV)/.browser: $(VENV)/.base
+	@if command -v chromium >/dev/null 2>&1 && command -v chromedriver >/dev/null 2>&1; then \
+		echo "browser: $$(command -v chromium), $$(command -v chromedriver)"; \
+	elif command -v apt-get >/dev/null 2>&1 && [ "$$(id -u)" = 0 ]; then \
+		echo "browser: installing chromium and chromium-driver (apt-get)"; \
+		(apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium chromium-driver) \
+			> $(VENV)/apt-browser.log 2>&1 || { tail -20 $(VENV)/apt-browser.log; exit 1; }; \
+	else \
+		echo "browser: no chromium and no root apt-get: tests/test_view_browser.py will be skipped"; \
+	fi
 	touch $@
 
 demo: $(VENV)/.base

@@ -111,6 +111,28 @@ def _printable(text: str) -> str:
     return "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
 
 
+def cmd_view(args) -> int:
+    import time
+
+    from uamopt.plotting.explore import explore
+
+    from uamopt.export.folder import read_schedule_folder
+
+    started = time.perf_counter()
+    read_schedule_folder(args.dir)  # bad input first, in one line, before the risk field is computed
+    out = Path(args.out) if args.out else Path(args.dir) / "view.html"
+    if out.is_dir():
+        raise UamoptError(f"--out is a folder: {out}", "--out", "give the HTML file to write, e.g. view.html")
+    if not out.parent.is_dir():
+        raise UamoptError(f"the folder of --out does not exist: {out.parent}", "--out", "create it or write elsewhere")
+    view = explore(args.dir, risk=args.risk, scenario=args.scenario, overrides=args.set, step_s=args.step,
+                   city=not args.no_city)
+    path = view.save(out)
+    frames = len(view.figure.frames)
+    print(f"view: {frames} frames, {path.stat().st_size / 1e6:.1f} MB, {time.perf_counter() - started:.1f} s -> {path}")
+    return 0
+
+
 def cmd_verify(args) -> int:
     """Read-only: verify writes nothing, so input it refuses leaves nothing behind."""
     from uamopt.schedule.verify import verify_dir
@@ -189,6 +211,17 @@ def build_parser() -> argparse.ArgumentParser:
                             description="check a schedule folder independently: exit 0 iff feasible and conflict-free")
     verify.add_argument("dir", help="folder with flights.json and schedule.csv")
     verify.set_defaults(func=cmd_verify)
+    view = sub.add_parser("view", help="write an offline interactive 3-D view of a schedule folder (one HTML file)",
+                          description="write an offline interactive 3-D view of a schedule folder: the city, the "
+                          "unsafe airspace per layer, the tracks and the flights played back (one HTML file, no network)")
+    view.add_argument("dir", help="a schedule folder written by uamopt schedule")
+    view.add_argument("--out", help="the HTML file (default: DIR/view.html)")
+    view.add_argument("--risk", help="risk.npz of the same scenario (default: recompute from the recorded one)")
+    view.add_argument("--scenario", help="scenario TOML when the folder records none")
+    view.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="override a scenario key")
+    view.add_argument("--step", type=float, metavar="SECONDS", help="playback clock step (default 10 s)")
+    view.add_argument("--no-city", action="store_true", help="leave out the buildings and the unsafe airspace")
+    view.set_defaults(func=cmd_view)
     command("reproduce", cmd_reproduce, "run every stage that applies and write report.md with figures", "out/reproduce")
     from uamopt.experiments.commands import add_sweep_command
     from uamopt.export.cli import add_export_commands

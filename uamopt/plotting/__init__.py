@@ -24,6 +24,9 @@ function                      draws                                             
 :func:`performance_profile`   Dolan–Moré profile of a benchmark table             1
 ============================  ==================================================  =========
 
+:func:`explore` is the one interactive view: a schedule folder in 3-D (plotly, an offline HTML file
+or inline in Jupyter; :mod:`uamopt.plotting.explore`), not a matplotlib Figure.
+
 Importing this package in Jupyter lets a returned Figure display as a PNG without pyplot
 (:func:`uamopt.plotting.style.show_figures_in`). This package imports matplotlib; ``import uamopt`` does not import it. The submodules ``risk``,
 ``tracks``, ``network`` and ``schedule`` are shadowed here by the functions of the same name
@@ -33,6 +36,7 @@ helpers are public in :mod:`uamopt.plotting.style` and :mod:`uamopt.plotting.geo
 
 from uamopt.experiments.bench_report import plot_performance_profile as performance_profile
 from uamopt.experiments.figures import plot_sweep as sweep
+from uamopt.plotting.explore import explore
 from uamopt.plotting.network import network
 from uamopt.plotting.risk import risk, risk_components
 from uamopt.plotting.schedule import delays, gantt
@@ -50,5 +54,5 @@ def _running_shell():
 
 show_figures_in(_running_shell())
 
-__all__ = ["DPI", "delays", "gantt", "network", "pareto", "performance_profile", "risk", "risk_components", "save",
+__all__ = ["DPI", "delays", "explore", "gantt", "network", "pareto", "performance_profile", "risk", "risk_components", "save",
            "sweep", "tracks"]
