@@ -61,8 +61,11 @@ def test_reproduce_writes_the_report(reproduced):
     assert "27.4684" in report  # terminal speed at m_p = 0 beside the reference 27.468
     assert "Table 2 analogue" in report and "Route network" in report
     expected = {"risk.npz", "risk.png", "summary.json", "report.md", "tracks.json", "tracks.png", "network.json",
-                "network.png", "pareto.png", "gantt.png", "delays.png", "gantt_weighted.png", "delays_weighted.png"}
+                "network.png", "pareto.png", "gantt.png", "delays.png", "gantt_weighted.png", "delays_weighted.png",
+                "view.html"}
     assert expected <= {p.name for p in reproduced.iterdir()}
+    view = (reproduced / "view.html").read_text(encoding="utf-8")  # the best schedule's 3-D playback (uamopt view)
+    assert "Plotly.addFrames" in view and '"name":"buildings"' in view
     for objective in ("lexicographic", "weighted"):  # a Gantt per solver, not only the best one's
         assert all((reproduced / "schedules" / objective / s / "gantt.png").stat().st_size > 0
                    for s in ("greedy", "ga", "soa", "highs", "cpsat"))

@@ -60,6 +60,9 @@ def schedule_sections(scenario: Scenario, network, stage: Path, bar, provenance:
             best = min((s for s in schedules.values() if s.objective is not None), key=lambda s: s.objective)
             plotting.save(plotting.gantt(problem, best), stage / f"gantt{suffix}.png")
             plotting.save(plotting.delays(problem, schedules), stage / f"delays{suffix}.png")
+            if objective == first and (stage / "risk.npz").is_file():  # the 3-D playback of the best schedule
+                name = next(n for n, s in schedules.items() if s is best)
+                plotting.explore(stage / "schedules" / objective / name, risk=stage / "risk.npz").save(stage / "view.html")
         sections.append(table3_section(problem, schedules, verified, suffix=suffix,
                                        paper=is_paper_schedule(scenario, problem)))
     return sections
