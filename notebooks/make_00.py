@@ -49,6 +49,14 @@ for name, schedule in schedules.items():
 print(f"objective: {problem.objective_kind} (most flights, then least delay; docs/readings.md)")
 assert schedules["highs"].status == "optimal"
 assert schedules["highs"].objective <= min(s.objective for s in schedules.values()) + 1e-6"""),
+    md("""## See it fly: the 3-D playback
+
+The city, the unsafe airspace per layer (toggle in the legend), the tracks, and the highs schedule
+played back at its times (slider, play, colour by route or delay; hover an aircraft). It is one
+offline HTML file: `view.save("view.html")`, or `uamopt view DIR` from the shell."""),
+    code("""view = ua.plotting.explore(problem, schedules["highs"], field=field)
+assert len(view.figure.frames) > 100 and view.figure.layout.meta["uamopt"]["rejected"] == []  # the verifier rejects no pair
+view"""),
     md("## A benchmark table (seeds × solvers, one time limit)"),
     code("""table = ua.benchmark(problem, ["greedy", "soa"], seeds=[0, 1], time_limit_s=10, progress=False)
 assert len(table) == 4 and table["verified"].all()

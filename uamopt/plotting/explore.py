@@ -153,13 +153,16 @@ def _risk_arrays(folder, risk, scenario, overrides) -> dict:
             "cell": tuple(f.grid.cell), "building_height": f.city.building_height, "no_fly": f.city.no_fly}
 
 
-def explore(path: str | Path, *, risk: str | Path | None = None, scenario: str | None = None,
+def explore(path, schedule=None, *, field=None, risk: str | Path | None = None, scenario: str | None = None,
             overrides: list[str] | None = None, step_s: float | None = None, city: bool = True) -> Explorer:
-    """The interactive 3-D view of the schedule folder ``path`` (module docstring).
+    """The interactive 3-D view of the schedule folder ``path`` (module docstring), or of a
+    schedule in memory: ``explore(problem, schedule, field=field)``.
 
     Parameters
     ----------
-    path : folder written by ``uamopt schedule``.
+    path : folder written by ``uamopt schedule``, or a SchedulingProblem (then ``schedule`` is its
+        Schedule, written to a temporary folder and read back as ``uamopt view`` reads it).
+    field : the RiskField of the schedule's scenario (in memory; instead of ``risk``).
     risk : a risk.npz of the same scenario, instead of recomputing the field from the recorded one.
     scenario, overrides : the scenario file (and ``--set`` keys) when the folder records none.
     step_s : the playback's clock step, s (default 10 s, larger where the schedule would need
@@ -175,7 +178,27 @@ def explore(path: str | Path, *, risk: str | Path | None = None, scenario: str |
     --------
     >>> view = ua.plotting.explore("out/sched")   # doctest: +SKIP
     >>> view.save("out/sched/view.html")           # doctest: +SKIP
+    >>> ua.plotting.explore(problem, schedule, field=field)   # in a notebook  # doctest: +SKIP
     """
+    from uamopt.schedule.model import SchedulingProblem
+
+    if isinstance(path, SchedulingProblem) or field is not None:
+        import tempfile
+
+        with tempfile.TemporaryDirectory(prefix="uamopt-view-") as tmp:
+            if isinstance(path, SchedulingProblem):
+                if schedule is None:
+                    raise TypeError("explore(problem, schedule): schedule is required with a problem")
+                from uamopt.schedule import write_schedule
+
+                write_schedule(Path(tmp) / "schedule", path, schedule)
+                path = Path(tmp) / "schedule"
+            if field is not None:
+                field.save_npz(Path(tmp) / "risk.npz")
+                risk = Path(tmp) / "risk.npz"
+            return explore(path, risk=risk, scenario=scenario, overrides=overrides, step_s=step_s, city=city)
+    if schedule is not None:
+        raise TypeError("explore(folder): a schedule is given only with its problem, explore(problem, schedule)")
     import plotly.graph_objects as go
 
     from uamopt.export.folder import read_schedule_folder
