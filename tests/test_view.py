@@ -202,3 +202,28 @@ def test_the_python_call_shows_inline_and_saves(viewed, tmp_path):
     saved = view.save(tmp_path / "v.html")
     assert saved.read_text(encoding="utf-8").lstrip().lower().startswith(("<!doctype html>", "<html"))
     assert '"name":"buildings"' not in saved.read_text(encoding="utf-8")  # city=False: no city
+
+
+def test_plan_network_and_risk_folders_are_viewed_without_playback(tmp_path):
+    """A plan folder shows its four stages (Table 2), a network folder its routes (the city from
+    --scenario: network.json records no scenario file), a risk folder the city; an empty folder
+    is one line and exit 2."""
+    plan, network, risk = tmp_path / "plan", tmp_path / "network", tmp_path / "risk"
+    fast = ["--set", "grid.cell=[100,100,30]", "--no-figures"]
+    assert main(["plan", str(PAPER_CASE), "--out", str(plan), *fast]) == 0
+    assert main(["view", str(plan)]) == 0
+    text = (plan / "view.html").read_text(encoding="utf-8")
+    stages = json.loads((plan / "tracks.json").read_text())["stages"]
+    assert set(stages) == {"shortest", "initial", "equivalent", "optimal"}
+    assert all(f'"name":"{s} track"' in text for s in stages) and '"name":"buildings"' in text
+    assert "Plotly.addFrames" not in text  # nothing to play
+    assert main(["network", str(PAPER_CASE), "--out", str(network), "--set", 'network.tracks="straight"', *fast]) == 0
+    assert main(["view", str(network), "--no-city"]) == 0
+    routes = json.loads((network / "network.json").read_text())["routes"]
+    text = (network / "view.html").read_text(encoding="utf-8")
+    assert len(routes) == 20 and all(f'"name":"track {r}"' in text for r in routes)
+    assert main(["risk", str(PAPER_CASE), "--out", str(risk), *fast]) == 0
+    assert main(["view", str(risk)]) == 0
+    assert '"name":"buildings"' in (risk / "view.html").read_text(encoding="utf-8")
+    (tmp_path / "empty").mkdir()
+    assert main(["view", str(tmp_path / "empty")]) == 2

@@ -119,7 +119,10 @@ def cmd_view(args) -> int:
     from uamopt.export.folder import read_schedule_folder
 
     started = time.perf_counter()
-    read_schedule_folder(args.dir)  # bad input first, in one line, before the risk field is computed
+    if not (Path(args.dir) / "schedule.csv").is_file() and Path(args.dir).is_dir():
+        pass  # a risk, plan, network or reproduce folder: explore checks it
+    else:
+        read_schedule_folder(args.dir)  # bad input first, in one line, before the risk field is computed
     out = Path(args.out) if args.out else Path(args.dir) / "view.html"
     if out.is_dir():
         raise UamoptError(f"--out is a folder: {out}", "--out", "give the HTML file to write, e.g. view.html")
@@ -129,7 +132,8 @@ def cmd_view(args) -> int:
                    city=not args.no_city)
     path = view.save(out)
     frames = len(view.figure.frames)
-    print(f"view: {frames} frames, {path.stat().st_size / 1e6:.1f} MB, {time.perf_counter() - started:.1f} s -> {path}")
+    playback = f"{frames} frames, " if frames else "no playback, "
+    print(f"view: {playback}{path.stat().st_size / 1e6:.1f} MB, {time.perf_counter() - started:.1f} s -> {path}")
     return 0
 
 
@@ -214,7 +218,7 @@ def build_parser() -> argparse.ArgumentParser:
     view = sub.add_parser("view", help="write an offline interactive 3-D view of a schedule folder (one HTML file)",
                           description="write an offline interactive 3-D view of a schedule folder: the city, the "
                           "unsafe airspace per layer, the tracks and the flights played back (one HTML file, no network)")
-    view.add_argument("dir", help="a schedule folder written by uamopt schedule")
+    view.add_argument("dir", help="a folder written by uamopt schedule (with playback), risk, plan, network or reproduce")
     view.add_argument("--out", help="the HTML file (default: DIR/view.html)")
     view.add_argument("--risk", help="risk.npz of the same scenario (default: recompute from the recorded one)")
     view.add_argument("--scenario", help="scenario TOML when the folder records none")

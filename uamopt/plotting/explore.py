@@ -153,6 +153,102 @@ def _risk_arrays(folder, risk, scenario, overrides) -> dict:
             "cell": tuple(f.grid.cell), "building_height": f.city.building_height, "no_fly": f.city.no_fly}
 
 
+STAGE_COLOUR = {"shortest": "#7f7f7f", "initial": "#1f77b4", "equivalent": "#ff7f0e", "optimal": "#2ca02c"}
+
+
+def _read_json(path: Path) -> dict:
+    import json
+
+    from uamopt.errors import InputFileError
+
+    try:
+        doc = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, ValueError) as exc:
+        raise InputFileError(f"cannot read {path.name}: {exc}", str(path), "rewrite it with uamopt") from None
+    if not isinstance(doc, dict):
+        raise InputFileError(f"{path.name} is not a JSON object", str(path), "rewrite it with uamopt")
+    return doc
+
+
+def _polyline(points, where: Path) -> np.ndarray:
+    from uamopt.errors import InputFileError
+
+    try:
+        wp = np.asarray(points, dtype=float)
+    except (TypeError, ValueError):
+        wp = np.zeros((0, 0))
+    if wp.ndim != 2 or wp.shape[1] != 3 or len(wp) < 2 or not np.isfinite(wp).all():
+        raise InputFileError("a track's waypoints are not a list of at least two finite [x, y, z]", str(where),
+                             "rewrite it with uamopt")
+    return wp
+
+
+def _static_view(here: Path, risk, scenario, overrides, city: bool, go) -> Explorer:
+    """A folder of ``uamopt risk``, ``plan``, ``network`` or ``reproduce``: the city, the unsafe
+    airspace and the tracks it holds (the four stages of Table 2, the network's routes), no playback."""
+    from uamopt.errors import InputFileError
+
+    tracks = here / "tracks.json"
+    network = here / "network.json"
+    npz = here / "risk.npz"
+    if not (tracks.is_file() or network.is_file() or npz.is_file()):
+        raise InputFileError("no schedule.csv, network.json, tracks.json or risk.npz in the folder", str(here),
+                             "give a folder written by uamopt risk, plan, network, schedule or reproduce")
+    lines, ports = [], {}
+    if network.is_file():
+        for name, r in (_read_json(network).get("routes") or {}).items():
+            wp = _polyline(r.get("waypoints") if isinstance(r, dict) else None, network)
+            lines.append((f"track {name}", wp, None))
+            a, _, b = str(name).partition("-")
+            ports.setdefault(a, wp[0])
+            ports.setdefault(b, wp[-1])
+    record = {}
+    if tracks.is_file():
+        doc = _read_json(tracks)
+        record = doc.get("scenario") if isinstance(doc.get("scenario"), dict) else {}
+        for stage, body in (doc.get("stages") or {}).items():
+            lines.append((f"{stage} track", _polyline(body.get("waypoints") if isinstance(body, dict) else None, tracks),
+                          STAGE_COLOUR.get(stage)))
+    traces = []
+    if city:
+        if risk is None and npz.is_file():
+            risk = npz
+        if risk is None and scenario is None and not record.get("file"):
+            raise InputFileError("the folder records no scenario file for the city", str(here),
+                                 "pass --scenario FILE (and its --set keys), --risk risk.npz, or --no-city")
+        if risk is not None:
+            arrays = _risk_arrays(None, risk, None, None)
+        else:
+            from uamopt.pipeline import compute_risk
+            from uamopt.scenario import load_scenario
+
+            f = compute_risk(load_scenario(scenario or record["file"], list(overrides or [])))
+            arrays = {"unsafe": f.unsafe, "obstacle": f.obstacle, "x": f.grid.x, "y": f.grid.y, "z": f.grid.z,
+                      "cell": tuple(f.grid.cell), "building_height": f.city.building_height, "no_fly": f.city.no_fly}
+        traces += _city_traces(arrays, go)
+    for n, (name, wp, colour) in enumerate(lines):
+        traces.append(go.Scatter3d(x=wp[:, 0], y=wp[:, 1], z=wp[:, 2], mode="lines", name=name, legendgroup="tracks",
+                                   line={"color": colour or PALETTE[n % len(PALETTE)], "width": 4},
+                                   hovertemplate=f"{html.escape(name)}<br>z %{{z:.0f}} m<extra></extra>"))
+    if ports:
+        names = sorted(ports)
+        xyz = np.array([ports[k] for k in names])
+        traces.append(go.Scatter3d(x=xyz[:, 0], y=xyz[:, 1], z=xyz[:, 2], mode="markers+text", name="vertiports",
+                                   text=names, textposition="top center",
+                                   marker={"size": 6, "color": "#000000", "symbol": "diamond"},
+                                   hovertemplate="vertiport %{text}<extra></extra>"))
+    what = "network" if network.is_file() else "plan" if tracks.is_file() else "risk field"
+    title = f"uamopt {what} {here.name}: {len(lines)} tracks"
+    fig = go.Figure(data=traces)
+    fig.update_layout(title={"text": html.escape(title), "x": 0.01},
+                      scene={"aspectmode": "data", "xaxis": {"title": {"text": "x (m)"}},
+                             "yaxis": {"title": {"text": "y (m)"}}, "zaxis": {"title": {"text": "z (m)"}}},
+                      legend={"itemsizing": "constant", "x": 1.0, "xanchor": "left", "y": 1.0},
+                      margin={"l": 0, "r": 230, "t": 60, "b": 0}, height=820, width=1280)
+    fig.layout.meta = {"uamopt": {"kind": what, "tracks": [name for name, _, _ in lines]}}
+    return Explorer(figure=fig, title=title)
+
+
 def explore(path, schedule=None, *, field=None, risk: str | Path | None = None, scenario: str | None = None,
             overrides: list[str] | None = None, step_s: float | None = None, city: bool = True) -> Explorer:
     """The interactive 3-D view of the schedule folder ``path`` (module docstring), or of a
@@ -160,7 +256,8 @@ def explore(path, schedule=None, *, field=None, risk: str | Path | None = None, 
 
     Parameters
     ----------
-    path : folder written by ``uamopt schedule``, or a SchedulingProblem (then ``schedule`` is its
+    path : folder written by ``uamopt schedule`` (or by ``risk``, ``plan``, ``network``,
+        ``reproduce``: the city and the tracks it holds, no playback), or a SchedulingProblem (then ``schedule`` is its
         Schedule, written to a temporary folder and read back as ``uamopt view`` reads it).
     field : the RiskField of the schedule's scenario (in memory; instead of ``risk``).
     risk : a risk.npz of the same scenario, instead of recomputing the field from the recorded one.
@@ -203,10 +300,13 @@ def explore(path, schedule=None, *, field=None, risk: str | Path | None = None, 
 
     from uamopt.export.folder import read_schedule_folder
 
-    folder = read_schedule_folder(path)
     if step_s is not None and not (isinstance(step_s, (int, float)) and math.isfinite(step_s) and step_s > 0):
         raise UamoptError(f"the playback step must be a positive number of seconds, got {step_s!r}", "--step",
                           "give e.g. 10")
+    here = Path(path)
+    if here.is_dir() and not (here / "schedule.csv").is_file():
+        return _static_view(here, risk, scenario, overrides, city, go)
+    folder = read_schedule_folder(path)
     traces = _city_traces(_risk_arrays(folder, risk, scenario, overrides), go) if city else []
     flights = folder.flights.flights
     routes = sorted({f.route for f in flights})
