@@ -135,6 +135,23 @@ def _city_traces(field, go) -> list:
     return traces
 
 
+def _vertiports(ports: dict, go) -> list:
+    """One marker trace of the vertiports (name -> [x, y, z]), labelled."""
+    if not ports:
+        return []
+    names = sorted(ports)
+    xyz = np.array([ports[n] for n in names])
+    return [go.Scatter3d(x=xyz[:, 0], y=xyz[:, 1], z=xyz[:, 2], mode="markers+text", name="vertiports", text=names,
+                         textposition="top center", marker={"size": 6, "color": "#000000", "symbol": "diamond"},
+                         hovertemplate="vertiport %{text}<extra></extra>")]
+
+
+def _field_arrays(f) -> dict:
+    """The arrays the city traces need, from a RiskField."""
+    return {"unsafe": f.unsafe, "obstacle": f.obstacle, "x": f.grid.x, "y": f.grid.y, "z": f.grid.z,
+            "cell": tuple(f.grid.cell), "building_height": f.city.building_height, "no_fly": f.city.no_fly}
+
+
 def _risk_arrays(folder, risk, scenario, overrides) -> dict:
     """The arrays the city traces need, from a risk.npz or the folder's recorded scenario."""
     if risk is not None:
@@ -148,9 +165,7 @@ def _risk_arrays(folder, risk, scenario, overrides) -> dict:
     from uamopt.export.folder import recorded_scenario
     from uamopt.pipeline import compute_risk
 
-    f = compute_risk(recorded_scenario(folder, scenario, overrides))
-    return {"unsafe": f.unsafe, "obstacle": f.obstacle, "x": f.grid.x, "y": f.grid.y, "z": f.grid.z,
-            "cell": tuple(f.grid.cell), "building_height": f.city.building_height, "no_fly": f.city.no_fly}
+    return _field_arrays(compute_risk(recorded_scenario(folder, scenario, overrides)))
 
 
 STAGE_COLOUR = {"shortest": "#7f7f7f", "initial": "#1f77b4", "equivalent": "#ff7f0e", "optimal": "#2ca02c"}
@@ -222,21 +237,13 @@ def _static_view(here: Path, risk, scenario, overrides, city: bool, go) -> Explo
             from uamopt.pipeline import compute_risk
             from uamopt.scenario import load_scenario
 
-            f = compute_risk(load_scenario(scenario or record["file"], list(overrides or [])))
-            arrays = {"unsafe": f.unsafe, "obstacle": f.obstacle, "x": f.grid.x, "y": f.grid.y, "z": f.grid.z,
-                      "cell": tuple(f.grid.cell), "building_height": f.city.building_height, "no_fly": f.city.no_fly}
+            arrays = _field_arrays(compute_risk(load_scenario(scenario or record["file"], list(overrides or []))))
         traces += _city_traces(arrays, go)
     for n, (name, wp, colour) in enumerate(lines):
         traces.append(go.Scatter3d(x=wp[:, 0], y=wp[:, 1], z=wp[:, 2], mode="lines", name=name, legendgroup="tracks",
                                    line={"color": colour or PALETTE[n % len(PALETTE)], "width": 4},
                                    hovertemplate=f"{html.escape(name)}<br>z %{{z:.0f}} m<extra></extra>"))
-    if ports:
-        names = sorted(ports)
-        xyz = np.array([ports[k] for k in names])
-        traces.append(go.Scatter3d(x=xyz[:, 0], y=xyz[:, 1], z=xyz[:, 2], mode="markers+text", name="vertiports",
-                                   text=names, textposition="top center",
-                                   marker={"size": 6, "color": "#000000", "symbol": "diamond"},
-                                   hovertemplate="vertiport %{text}<extra></extra>"))
+    traces += _vertiports(ports, go)
     what = "network" if network.is_file() else "plan" if tracks.is_file() else "risk field"
     title = f"uamopt {what} {here.name}: {len(lines)} tracks"
     fig = go.Figure(data=traces)
@@ -324,13 +331,7 @@ def explore(path, schedule=None, *, field=None, risk: str | Path | None = None, 
     for f in flights:
         ports.setdefault(f.origin, np.asarray(f.waypoints[0], float))
         ports.setdefault(f.destination, np.asarray(f.waypoints[-1], float))
-    if ports:
-        names = sorted(ports)
-        xyz = np.array([ports[n] for n in names])
-        traces.append(go.Scatter3d(x=xyz[:, 0], y=xyz[:, 1], z=xyz[:, 2], mode="markers+text", name="vertiports",
-                                   text=names, textposition="top center",
-                                   marker={"size": 6, "color": "#000000", "symbol": "diamond"},
-                                   hovertemplate="vertiport %{text}<extra></extra>"))
+    traces += _vertiports(ports, go)
     operated = folder.operated
     rejected = _rejected_flights(folder.path, {f.id for f in flights})
     if operated:
