@@ -95,17 +95,74 @@ def test_an_interrupt_stops_a_long_solve_at_once(solver, sig, raised):
     assert name == raised and 8 <= int(seconds.split()[0]) < 90, done.stderr
 
 
-def test_a_signal_that_cuts_an_extension_import_is_still_an_interrupt(monkeypatch):
-    """SIGTERM during shapely's Cython initialisation surfaced as ImportError("PyCapsule_Import could
-    not import module 'shapely'") with no chain to the Terminated our handler raised: the CLI
-    printed a traceback (seen once in CI, test_output_safety's sigterm case). The handler now
-    records what it raised, and interrupt_of finds it behind such an ImportError only."""
+def _swallowed(signum: int) -> Exception:
+    """What an extension module does when our handler raises inside it: drops the interrupt and
+    returns an error of its own, with no chain back (no ``__context__``, as from C)."""
+    from uamopt import interrupts
+
+    try:
+        (interrupts._raise_terminated if signum == 15 else interrupts._raise_interrupt)(signum, None)
+    except KeyboardInterrupt:
+        pass
+    return ValueError("Invalid affine transformation matrix")
+
+
+@pytest.mark.parametrize("error", [ImportError('PyCapsule_Import could not import module "shapely"'),
+                                   ValueError("Invalid affine transformation matrix")])
+def test_an_error_with_no_chain_is_the_interrupt_only_after_a_signal(monkeypatch, error):
+    """SIGTERM during shapely's Cython initialisation surfaced as an ImportError, and SIGTERM inside
+    matplotlib's Agg ``draw_path`` (uamopt risk writing its figures) as ValueError("Invalid affine
+    transformation matrix"), neither chained to the Terminated our handler raised: the CLI printed
+    a traceback (both seen in CI, test_output_safety's random interrupts). The handler records
+    what it raised, and interrupt_of finds it behind any error once a signal came."""
     from uamopt import interrupts
 
     monkeypatch.setattr(interrupts, "_LAST", [])
-    cut = ImportError('PyCapsule_Import could not import module "shapely"')
-    assert interrupts.interrupt_of(cut) is None  # no signal came: a real import error stays one
-    with pytest.raises(interrupts.Terminated) as raised:
-        interrupts._raise_terminated(15, None)
-    assert interrupts.interrupt_of(cut) is raised.value
-    assert interrupts.interrupt_of(ValueError("unrelated")) is None  # only an import can be cut so
+    assert interrupts.interrupt_of(error) is None  # no signal came: a real error stays one
+    assert error.__context__ is None and error.__cause__ is None
+    _swallowed(15)
+    found = interrupts.interrupt_of(error)
+    assert isinstance(found, interrupts.Terminated) and interrupts.handled(found) == interrupts.EXIT_SIGTERM
+    monkeypatch.setattr(interrupts, "_LAST", [])
+    _swallowed(2)
+    found = interrupts.interrupt_of(error)
+    assert type(found) is KeyboardInterrupt and interrupts.handled(found) == interrupts.EXIT_SIGINT
+
+
+CLI_CUT = """import os, signal, sys
+import uamopt.cli as cli
+
+def cut(args):  # a command whose library drops the interrupt and raises its own error (matplotlib's Agg)
+    try:
+        os.kill(os.getpid(), signal.SIGTERM)
+        signal.pthread_kill(signal.pthread_self(), 0)  # run the handler now
+    except KeyboardInterrupt:
+        pass
+    raise ValueError("Invalid affine transformation matrix")
+
+def plain(args):
+    raise ValueError("a real bug")
+
+parser = cli.build_parser
+def patched():
+    p = parser()
+    for name, func in (("cut", cut), ("plain", plain)):
+        p._subparsers._group_actions[0].add_parser(name).set_defaults(func=func)
+    return p
+cli.build_parser = patched
+sys.exit(cli.main([sys.argv[1]]))
+"""
+
+
+@pytest.mark.parametrize(("command", "code", "line"), [("cut", 143, "terminated: nothing was written\n"),
+                                                      ("plain", 1, None)])
+def test_the_cli_reports_a_swallowed_sigterm_as_one_line(command, code, line):
+    """Through ``uamopt.cli.main`` in a fresh interpreter: the error that replaced the interrupt is
+    one line and exit 143; the same error with no signal is still a traceback (a bug stays one)."""
+    done = subprocess.run([sys.executable, "-c", CLI_CUT, command], cwd=ROOT, capture_output=True, text=True,
+                          check=False, timeout=120)
+    assert done.returncode == code, done.stderr
+    if line is None:
+        assert "Traceback" in done.stderr and "a real bug" in done.stderr
+    else:
+        assert done.stderr == line

@@ -78,9 +78,12 @@ def install_handlers() -> None:
 
 def interrupt_of(exc: BaseException) -> KeyboardInterrupt | None:
     """The interrupt behind ``exc``: itself, or one in its cause/context chain (a library may
-    wrap a KeyboardInterrupt raised inside its callback in an error of its own), or, for an
-    ImportError, the interrupt our handler raised last (a signal that cut an extension module's
-    initialisation surfaces as that module's ImportError, with no chain)."""
+    wrap a KeyboardInterrupt raised inside its callback in an error of its own), or else the
+    interrupt our handler raised last, if one was: an extension module that a signal cut may drop
+    it and raise an error of its own with no chain (shapely's Cython initialisation raised
+    ImportError "PyCapsule_Import could not import module"; matplotlib's Agg renderer, cut inside
+    ``draw_path``, raised ValueError "Invalid affine transformation matrix"). Once the process was
+    told to stop, an error on the way out is that stop, not a bug to print."""
     seen = set()
     first = exc
     while exc is not None and id(exc) not in seen:
@@ -88,7 +91,7 @@ def interrupt_of(exc: BaseException) -> KeyboardInterrupt | None:
             return exc
         seen.add(id(exc))
         exc = exc.__cause__ or exc.__context__
-    if isinstance(first, ImportError) and _LAST:
+    if _LAST:
         return _LAST[0]
     return None
 
