@@ -61,6 +61,27 @@ def figure_frames(text: str) -> list[dict]:
     return frames
 
 
+def figure_data(text: str) -> list[dict]:
+    """The traces plotly wrote into the page (the data argument of Plotly.newPlot)."""
+    at = re.search(r"Plotly\.newPlot\(\s*\"[^\"]+\",\s*", text)
+    assert at, "no figure in the page"
+    data, _ = json.JSONDecoder().raw_decode(text, at.end())
+    return data
+
+
+def route_colours(data: list[dict]):
+    """value -> colour of the aircraft coloured by route, decoded as plotly.js maps a marker's value:
+    its position (v - cmin) / (cmax - cmin) on the trace's colour-scale stops."""
+    base = next(tr for tr in data if tr["name"] == "aircraft (colour: route)")["marker"]
+    scale, lo, hi = base["colorscale"], base["cmin"], base["cmax"]
+
+    def colour(value: float) -> str:
+        at = (value - lo) / (hi - lo)
+        return next(c for (p0, c), (p1, _) in itertools.pairwise(scale) if p0 <= at <= p1)
+
+    return colour
+
+
 def values(v) -> list:
     """A data array as plotly writes it: a JSON list, or a typed array {"dtype", "bdata": base64}."""
     if isinstance(v, dict) and "bdata" in v:
@@ -110,11 +131,13 @@ def test_the_playback_puts_each_aircraft_where_the_schedule_says(viewed):
     meta = json.loads(re.search(r'"meta":\s*(\{"uamopt".*?\}\})', text).group(1))["uamopt"]
     clock = meta["times_s"]
     assert len(frames) == len(clock) >= 50 and meta["step_s"] == pytest.approx(10.0)
+    with open(folder / "schedule.csv", newline="") as fh:
+        rows = {r["flight"]: r for r in csv.DictReader(fh)}
     seen = set()
     checked = 0
     for frame, t in zip(frames, clock):
         by_route = frame["data"][0]  # the aircraft coloured by route
-        ids = [re.match(r"flight (\S+)<br>", h).group(1) for h in by_route["text"]]
+        ids = [c[0] for c in by_route["customdata"]]  # the hover's flight id
         airborne = {fid for fid, (times, _) in plans.items() if times[0] <= t <= times[-1]}
         assert set(ids) == airborne, t
         xs, ys, zs = (values(by_route[k]) for k in "xyz")
@@ -122,12 +145,40 @@ def test_the_playback_puts_each_aircraft_where_the_schedule_says(viewed):
         for fid, x, y, z in zip(ids, xs, ys, zs):
             times, wp = plans[fid]
             want = [np.interp(t, times, wp[:, k]) for k in range(3)]
-            assert [x, y, z] == pytest.approx(want, abs=1e-6), (fid, t)
+            assert [x, y, z] == pytest.approx(want, abs=1e-2), (fid, t)  # float32 in the page: < 1 mm at 3 km
             checked += 1
+        for custom in by_route["customdata"]:  # the hover: aircraft, route and delay of schedule.csv
+            row = rows[custom[0]]
+            delay = float(row["departure_s"]) - float(row["planned_departure_s"])
+            assert custom[1:] == [row["aircraft"], row["route"], f"{delay:.1f}"]
+        by_delay = frame["data"][1]  # the same aircraft, coloured by their delay
+        assert [c[0] for c in by_delay["customdata"]] == ids and values(by_delay["x"]) == xs
+        for fid, value in zip(ids, values(by_delay["marker"]["color"])):
+            row = rows[fid]
+            assert value == pytest.approx(float(row["departure_s"]) - float(row["planned_departure_s"]), abs=1e-3)
         seen |= set(ids)
     assert seen == set(plans) and checked > 100  # every operated flight flies in the playback
     assert meta["cancelled"] == sorted({json.loads((folder / "flights.json").read_text())["flights"][i]["id"]
                                            for i in range(12)} - set(plans))
+
+
+def test_each_aircraft_has_its_tracks_colour(viewed):
+    """Colour by route: an aircraft's marker value, through the trace's stepped colour scale, is the
+    colour of its route's track line (the scale is decoded here as plotly.js maps it)."""
+    folder, page = viewed
+    text = page.read_text(encoding="utf-8")
+    data = figure_data(text)
+    line = {tr["name"].removeprefix("track "): tr["line"]["color"] for tr in data if tr["name"].startswith("track ")}
+    colour = route_colours(data)
+    with open(folder / "schedule.csv", newline="") as fh:
+        route = {r["flight"]: r["route"] for r in csv.DictReader(fh)}
+    seen = 0
+    for frame in figure_frames(text):
+        trace = frame["data"][0]
+        for custom, value in zip(trace["customdata"], values(trace["marker"]["color"])):
+            assert colour(value) == line[route[custom[0]]], custom
+            seen += 1
+    assert seen > 100
 
 
 def test_the_city_and_the_unsafe_layers_are_drawn(viewed):
@@ -171,7 +222,19 @@ def test_a_verifier_rejected_pair_is_drawn_red(tmp_path):
     text = (folder / "view.html").read_text(encoding="utf-8")
     meta = json.loads(re.search(r'"meta":\s*(\{"uamopt".*?\}\})', text).group(1))["uamopt"]
     assert {a["flight"], b["flight"]} <= set(meta["rejected"])
-    assert "verifier rejects" in text and "#d62728" in text
+    assert "verifier rejects" in text
+    colour = route_colours(figure_data(text))
+    drawn = {}  # flight -> set of (colour, size) over the frames
+    for frame in figure_frames(text):
+        trace = frame["data"][0]
+        sizes = values(trace["marker"]["size"]) if isinstance(trace["marker"]["size"], dict) else None
+        for n, (custom, value) in enumerate(zip(trace["customdata"], values(trace["marker"]["color"]))):
+            drawn.setdefault(custom[0], set()).add((colour(value), sizes[n] if sizes else trace["marker"]["size"]))
+    red = {fid for fid, seen in drawn.items() if all(c == "#d62728" for c, _ in seen)}
+    assert red == set(meta["rejected"]) and {a["flight"], b["flight"]} <= red
+    big = max(size for seen in drawn.values() for _, size in seen)
+    assert all(seen == {("#d62728", big)} for fid, seen in drawn.items() if fid in red)  # red and larger
+    assert all(all(c != "#d62728" and s < big for c, s in seen) for fid, seen in drawn.items() if fid not in red)
 
 
 @pytest.mark.parametrize("args, fragment", [

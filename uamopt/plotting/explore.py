@@ -45,28 +45,63 @@ CONFLICT_COLOUR = "#d62728"
 BUILDING_COLOUR = "#8c8c8c"
 UNSAFE_COLOUR = "#e6550d"
 SPEEDS = {"1×": 120, "4×": 30, "16×": 8}  # frame durations, ms
+AIRCRAFT_SIZE = 10  # px; a flight in a pair the verifier rejects is drawn 5 px larger
+SCENE = {"aspectmode": "data", "camera": {"eye": {"x": 0.7, "y": -2.6, "z": 2.6}},  # from the south, above: the city whole
+         "xaxis": {"title": {"text": "x (m)"}}, "yaxis": {"title": {"text": "y (m)"}},
+         "zaxis": {"title": {"text": "z (m)"}}}
 
 
 @dataclass
 class Explorer:
-    """The view: ``figure`` (a plotly Figure), shown inline in Jupyter, written by :meth:`save`."""
+    """The view, shown inline in Jupyter and written by :meth:`save`: ``spec`` is the plotly figure
+    as plain JSON-ready data (written without plotly's per-attribute validation, which took most of
+    a minute for 1,000 flights); :attr:`figure` builds the plotly Figure from it on demand."""
 
-    figure: object
+    spec: dict
     title: str
+
+    @property
+    def figure(self):
+        """The view as a ``plotly.graph_objects.Figure`` (validated; built on each call)."""
+        import plotly.graph_objects as go
+
+        return go.Figure(self.spec)
+
+    def _html(self, full: bool) -> str:
+        import plotly.io as pio
+
+        return pio.to_html(self.spec, include_plotlyjs=True, full_html=full, auto_play=False, validate=False,
+                           config={"displaylogo": False})
 
     def save(self, path: str | Path) -> Path:
         """Write the view as one self-contained HTML file (plotly.js inlined: no network needed)."""
         from uamopt.experiments.store import atomic_write
 
         path = Path(path)
-        text = self.figure.to_html(include_plotlyjs=True, full_html=True, auto_play=False,
-                                   config={"displaylogo": False})
-        text = text.replace("<head>", f"<head><title>{html.escape(self.title)}</title>", 1)
+        text = self._html(True).replace("<head>", f"<head><title>{html.escape(self.title)}</title>", 1)
         atomic_write(path, lambda p: p.write_text(text, encoding="utf-8"))
         return path
 
     def _repr_html_(self) -> str:  # Jupyter: inline, offline (plotly.js in the cell's output)
-        return self.figure.to_html(include_plotlyjs=True, full_html=False, auto_play=False)
+        return self._html(False)
+
+
+def _typed(a, dtype: str) -> dict:
+    """An array as plotly.js's typed-array spec (little-endian, base64): float32 positions take
+    5.3 characters a number instead of JSON's 10 to 18."""
+    import base64
+
+    raw = np.ascontiguousarray(a, dtype=np.dtype(dtype).newbyteorder("<")).tobytes()
+    return {"dtype": dtype, "bdata": base64.b64encode(raw).decode("ascii")}
+
+
+def _plain(traces: list) -> list[dict]:
+    """plotly graph objects as the JSON plotly writes for them (arrays as typed-array specs)."""
+    import json
+
+    import plotly.io as pio
+
+    return json.loads(pio.to_json({"data": traces, "layout": {}}, validate=False, engine="json"))["data"] if traces else []
 
 
 def _flight_positions(operated, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -246,14 +281,11 @@ def _static_view(here: Path, risk, scenario, overrides, city: bool, go) -> Explo
     traces += _vertiports(ports, go)
     what = "network" if network.is_file() else "plan" if tracks.is_file() else "risk field"
     title = f"uamopt {what} {here.name}: {len(lines)} tracks"
-    fig = go.Figure(data=traces)
-    fig.update_layout(title={"text": html.escape(title), "x": 0.01},
-                      scene={"aspectmode": "data", "xaxis": {"title": {"text": "x (m)"}},
-                             "yaxis": {"title": {"text": "y (m)"}}, "zaxis": {"title": {"text": "z (m)"}}},
-                      legend={"itemsizing": "constant", "x": 1.0, "xanchor": "left", "y": 1.0},
-                      margin={"l": 0, "r": 230, "t": 60, "b": 0}, height=820, width=1280)
-    fig.layout.meta = {"uamopt": {"kind": what, "tracks": [name for name, _, _ in lines]}}
-    return Explorer(figure=fig, title=title)
+    layout = {"title": {"text": html.escape(title), "x": 0.01}, "scene": SCENE,
+              "legend": {"itemsizing": "constant", "x": 1.0, "xanchor": "left", "y": 1.0},
+              "margin": {"l": 0, "r": 230, "t": 60, "b": 0}, "height": 820, "width": 1280,
+              "meta": {"uamopt": {"kind": what, "tracks": [name for name, _, _ in lines]}}}
+    return Explorer(spec={"data": _plain(traces), "layout": layout}, title=title)
 
 
 def explore(path, schedule=None, *, field=None, risk: str | Path | None = None, scenario: str | None = None,
@@ -350,65 +382,78 @@ def explore(path, schedule=None, *, field=None, risk: str | Path | None = None, 
     max_delay = float(delay.max()) if len(delay) and delay.max() > 0 else 1.0
     label = [f"{o.flight.id}" for o in operated]
 
-    def aircraft_traces(k: int) -> list:
+    route_index = {r: i for i, r in enumerate(routes)}
+    category = np.array([len(routes) if label[i] in rejected else route_index[o.flight.route]
+                         for i, o in enumerate(operated)], dtype=np.uint16)
+    hover = [[html.escape(label[i]), html.escape(o.flight.aircraft), html.escape(o.flight.route), f"{delay[i]:.1f}"]
+             for i, o in enumerate(operated)]  # the same for a flight at every frame; its altitude from z
+    template = ("flight %{customdata[0]}<br>aircraft %{customdata[1]}<br>route %{customdata[2]}<br>"
+                "delay %{customdata[3]} s<br>z %{z:.0f} m<extra></extra>")
+    big = np.array([label[i] in rejected for i in range(len(operated))], dtype=bool)
+
+    def aircraft_traces(k: int) -> list[dict]:
+        """The airborne aircraft at frame k, twice (coloured by route, by delay): only what changes
+        from frame to frame (positions, who is airborne); colour scales and the template in the
+        first frame's traces. Positions in float32 (a millimetre at 20 km)."""
         on = np.flatnonzero(live[:, k])
-        hover = [f"flight {html.escape(label[i])}<br>aircraft {html.escape(operated[i].flight.aircraft)}<br>"
-                 f"route {html.escape(operated[i].flight.route)}<br>delay {delay[i]:.1f} s<br>z {pos[i, k, 2]:.0f} m"
-                 for i in on]
-        bad = np.array([label[i] in rejected for i in on], dtype=bool)
-        size = np.where(bad, 12, 8) if len(on) else []
-        common = {"x": pos[on, k, 0], "y": pos[on, k, 1], "z": pos[on, k, 2], "mode": "markers", "text": hover,
-                  "hovertemplate": "%{text}<extra></extra>"}
-        by_route = [CONFLICT_COLOUR if b else colour[operated[i].flight.route] for i, b in zip(on, bad)]
-        return [go.Scatter3d(**common, name="aircraft (colour: route)",
-                             marker={"size": size, "color": by_route, "line": {"color": "#000000", "width": 2}}),
-                go.Scatter3d(**common, name="aircraft (colour: delay)", visible=False,
-                             marker={"size": size, "color": delay[on] if len(on) else [], "colorscale": "Viridis",
-                                     "cmin": 0.0, "cmax": max_delay, "line": {"color": np.where(bad, CONFLICT_COLOUR, "#ffffff")
-                                                                              if len(on) else [], "width": 1},
-                                     "colorbar": {"title": {"text": "delay (s)"}, "x": 1.02, "len": 0.5}})]
+        xyz = {c: _typed(pos[on, k, n], "f4") for n, c in enumerate("xyz")}
+        custom = [hover[i] for i in on]
+        size = _typed(np.where(big[on], AIRCRAFT_SIZE + 5, AIRCRAFT_SIZE), "u1") if big.any() else AIRCRAFT_SIZE
+        return [{"type": "scatter3d", **xyz, "customdata": custom, "marker": {"color": _typed(category[on], "u2"),
+                                                                             "size": size}},
+                {"type": "scatter3d", **xyz, "customdata": custom, "marker": {"color": _typed(delay[on], "f4"),
+                                                                             "size": size}}]
 
     first = len(traces)
-    traces += aircraft_traces(0)
+    n_cat = len(routes) + 1  # the routes' colours, then the conflict colour
+    steps = [[edge / n_cat, c] for k, c in enumerate([colour[r] for r in routes] + [CONFLICT_COLOUR])
+             for edge in (k, k + 1)]
+    by_route, by_delay = aircraft_traces(0)
+    by_route.update(name="aircraft (colour: route)", mode="markers", hovertemplate=template)
+    by_route["marker"].update(colorscale=steps, cmin=-0.5, cmax=n_cat - 0.5, showscale=False,
+                              line={"color": "#000000", "width": 2})
+    by_delay.update(name="aircraft (colour: delay)", mode="markers", hovertemplate=template, visible=False)
+    by_delay["marker"].update(colorscale="Viridis", cmin=0.0, cmax=max_delay, showscale=True,
+                              line={"color": "#ffffff", "width": 1},
+                              colorbar={"title": {"text": "delay (s)"}, "x": 1.02, "len": 0.5})
+    data = _plain(traces) + [by_route, by_delay]
     clock = [f"{int(t // 3600):02d}:{int(t % 3600 // 60):02d}:{int(t % 60):02d}" for t in times]
-    frames = [go.Frame(name=clock[k], data=aircraft_traces(k), traces=[first, first + 1]) for k in range(len(times))]
+    frames = [{"name": clock[k], "data": aircraft_traces(k), "traces": [first, first + 1]} for k in range(len(times))]
     cancelled = [f.id for f in flights if f.id not in {o.flight.id for o in operated}]
     title = f"uamopt schedule {folder.path.name}: {len(operated)} operated, {len(cancelled)} cancelled"
     if rejected:
         title += f"; verifier rejects {len(rejected)} flights (red)"
     shown = ", ".join(cancelled[:30]) + (f" … (+{len(cancelled) - 30})" if len(cancelled) > 30 else "")
-    fig = go.Figure(data=traces, frames=frames)
-    n_traces = len(traces)
+    n_traces = len(data)
     vis_route = [True] * n_traces
     vis_delay = [True] * n_traces
     vis_route[first + 1] = False
     vis_delay[first] = False
-    for n, tr in enumerate(traces[:first]):  # keep what the legend has hidden hidden
-        if getattr(tr, "visible", None) == "legendonly":
+    for n, tr in enumerate(data[:first]):  # keep what the legend has hidden hidden
+        if tr.get("visible") == "legendonly":
             vis_route[n] = vis_delay[n] = "legendonly"
     play = [{"label": f"▶ {name}", "method": "animate",
              "args": [None, {"frame": {"duration": ms, "redraw": True}, "fromcurrent": True, "transition": {"duration": 0},
                              "mode": "immediate"}]} for name, ms in SPEEDS.items()]
     pause = {"label": "❚❚", "method": "animate",
              "args": [[None], {"frame": {"duration": 0, "redraw": False}, "mode": "immediate", "transition": {"duration": 0}}]}
-    fig.update_layout(
-        title={"text": html.escape(title) + (f"<br><sup>cancelled: {html.escape(shown)}</sup>" if cancelled else ""),
-               "x": 0.01},
-        scene={"aspectmode": "data", "xaxis": {"title": {"text": "x (m)"}}, "yaxis": {"title": {"text": "y (m)"}},
-               "zaxis": {"title": {"text": "z (m)"}}},
-        legend={"itemsizing": "constant", "x": 1.0, "xanchor": "left", "y": 1.0},
-        margin={"l": 0, "r": 230, "t": 70, "b": 130}, height=820, width=1280, uirevision="keep",
-        updatemenus=[
+    layout = {
+        "title": {"text": html.escape(title) + (f"<br><sup>cancelled: {html.escape(shown)}</sup>" if cancelled else ""),
+                  "x": 0.01},
+        "scene": SCENE,
+        "legend": {"itemsizing": "constant", "x": 1.0, "xanchor": "left", "y": 1.0},
+        "margin": {"l": 0, "r": 230, "t": 70, "b": 130}, "height": 820, "width": 1280, "uirevision": "keep",
+        "updatemenus": [
             {"type": "buttons", "direction": "left", "x": 0.0, "y": 0.0, "xanchor": "left", "yanchor": "top",
              "buttons": play + [pause], "showactive": False, "pad": {"t": 75}},
             {"type": "dropdown", "x": 0.32, "y": 0.0, "xanchor": "left", "yanchor": "top", "pad": {"t": 75},
              "buttons": [{"label": "colour: route", "method": "restyle", "args": [{"visible": vis_route}]},
                          {"label": "colour: delay", "method": "restyle", "args": [{"visible": vis_delay}]}]}],
-        sliders=[{"active": 0, "x": 0.0, "y": 0.0, "yanchor": "top", "len": 1.0, "pad": {"t": 5},
-                  "currentvalue": {"prefix": "clock "},
-                  "steps": [{"label": clock[k], "method": "animate",
-                             "args": [[clock[k]], {"frame": {"duration": 0, "redraw": True}, "mode": "immediate",
-                                                   "transition": {"duration": 0}}]} for k in range(len(times))]}])
-    fig.layout.meta = {"uamopt": {"times_s": times.tolist(), "flights": label, "step_s": step,
-                                  "cancelled": cancelled, "rejected": sorted(rejected)}}
-    return Explorer(figure=fig, title=title)
+        "sliders": [{"active": 0, "x": 0.0, "y": 0.0, "yanchor": "top", "len": 1.0, "pad": {"t": 5},
+                     "currentvalue": {"prefix": "clock "},
+                     "steps": [{"label": clock[k], "method": "animate",
+                                "args": [[clock[k]], {"frame": {"duration": 0, "redraw": True}, "mode": "immediate",
+                                                      "transition": {"duration": 0}}]} for k in range(len(times))]}],
+        "meta": {"uamopt": {"times_s": times.tolist(), "flights": label, "step_s": step,
+                            "cancelled": cancelled, "rejected": sorted(rejected)}}}
+    return Explorer(spec={"data": data, "layout": layout, "frames": frames}, title=title)
