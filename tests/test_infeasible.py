@@ -65,3 +65,29 @@ def test_a_feasible_pin_still_solves(name):
     schedule = ua.solve(problem, name, time_limit_s=20)
     assert schedule.status in ("optimal", "optimal_on_grid") and schedule.operated.tolist() == [True, False]
     assert ua.verify(problem, schedule).ok
+
+
+@pytest.mark.parametrize("name", ["highs", "greedy"])
+def test_raise_for_status_names_the_reason_and_nothing_is_written(name, tmp_path):
+    """``InfeasibleScheduleError`` where the API promises an exception: ``raise_for_status`` (the
+    status stays the answer of ``solve``), and ``write_schedule`` / ``ua.verify``, which have no
+    schedule to write; a proof names the pinned flights, a heuristic says it proves nothing."""
+    from uamopt.errors import InfeasibleScheduleError
+    from uamopt.schedule import write_schedule
+
+    problem = crossing("lexicographic")
+    schedule = ua.solve(problem, name, time_limit_s=20)
+    assert schedule.status == "infeasible"
+    with pytest.raises(InfeasibleScheduleError) as raised:
+        schedule.raise_for_status()
+    line = raised.value.line()
+    assert f"(solver {name})" in line and "must_operate" in line
+    assert ("A1" in line and "infeasible" in line) if name == "highs" else "not a proof" in line
+    with pytest.raises(InfeasibleScheduleError):
+        write_schedule(tmp_path / "out", problem, schedule)
+    assert not (tmp_path / "out").exists()
+    with pytest.raises(InfeasibleScheduleError):
+        ua.verify(problem, schedule)
+    feasible = dataclasses.replace(problem, must_operate=np.array([True, False]))
+    solved = ua.solve(feasible, name, time_limit_s=20)
+    assert solved.raise_for_status() is solved  # a schedule: returned as it is

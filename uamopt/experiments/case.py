@@ -67,7 +67,8 @@ def schedule_row(problem, schedule, seconds: float) -> dict:
             "objective_kind": problem.objective_kind, "objective": objective, "bound": bound, "gap": gap,
             "operated": schedule.operated_count, "cancelled": schedule.cancelled,
             "total_delay_s": schedule.total_delay_s, "avg_delay_s": schedule.avg_delay_s,
-            "verified": verify(problem, schedule).ok, "seconds": seconds}
+            "verified": schedule.status != "infeasible" and verify(problem, schedule).ok,  # infeasible: no schedule
+            "seconds": seconds}
 
 
 def network_totals(network) -> dict:

@@ -265,6 +265,22 @@ class Schedule:
         if self.status not in STATUSES:
             raise UamoptError(f"unknown status '{self.status}'", f"solver {self.solver}", f"use one of {', '.join(STATUSES)}")
 
+    def raise_for_status(self) -> Schedule:
+        """``self``, or :class:`~uamopt.errors.InfeasibleScheduleError` when the status is
+        ``infeasible`` (no schedule operates the must-operate flights within the families), with the
+        solver's reason: ``ua.solve(problem, "highs").raise_for_status()`` for code that wants an
+        exception rather than a status (as ``requests``' ``Response.raise_for_status``). Any other
+        status, ``time_limit`` included, is a schedule and returns it."""
+        if self.status != "infeasible":
+            return self
+        from uamopt.errors import InfeasibleScheduleError
+
+        proved = self.extras.get("reason")
+        what = (f"the problem is infeasible: {proved}" if proved else
+                "no schedule operating every must-operate flight was found (a heuristic: not a proof)")
+        raise InfeasibleScheduleError(what, f"solver {self.solver}",
+                                      "pin fewer flights (must_operate) or widen their delay bounds")
+
     @property
     def operated_count(self) -> int:
         """S (Eq. 22)."""
@@ -337,7 +353,9 @@ def write_schedule(out_dir: str | Path, problem: SchedulingProblem, schedule: Sc
     ``summary.json`` carries the docs/interfaces.md keys plus ``weights``, ``objective_kind``,
     ``aircraft`` (G) and ``flights`` so the verifier can recompute the objective; ``extra`` adds
     keys (``uamopt schedule`` adds ``frame`` and ``scenario`` for the exports, uamopt.export.frame).
+    An ``infeasible`` schedule is no schedule: :meth:`Schedule.raise_for_status` raises before anything is written.
     """
+    schedule.raise_for_status()
     from uamopt.outputs import staged_output, write_json
 
     from uamopt.schedule.families.speed import collapse, speed_choice_of
