@@ -17,6 +17,7 @@ raised inside a C callback (numba's compiler calls Python back through ctypes) w
 
 from __future__ import annotations
 
+import logging
 import os
 import signal
 import sys
@@ -74,6 +75,24 @@ def install_handlers() -> None:
             signal.signal(signal.SIGINT, _raise_interrupt)
         if not getattr(sys.unraisablehook, "uamopt", False):
             sys.unraisablehook = _unraisable_hook(sys.unraisablehook)
+
+
+class _NotDuringAnInterrupt(logging.Filter):
+    """Drops a record logged while a KeyboardInterrupt is being handled (the logging call inside
+    the library's ``except:``, as :func:`sys.exc_info` then shows)."""
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        return not isinstance(sys.exc_info()[1], KeyboardInterrupt)
+
+
+def quiet_on_interrupt(logger: str) -> None:
+    """Keep a library from logging an interrupt as its own error: Pyomo's ``pyomo.core`` logs
+    "ERROR: Constructing component 'gap_below' from data=None failed: KeyboardInterrupt" on stdout
+    when Ctrl-C lands while a model is built, then re-raises it (seen in CI). The interrupt itself
+    still propagates; only the record is dropped. Idempotent."""
+    log = logging.getLogger(logger)
+    if not any(isinstance(f, _NotDuringAnInterrupt) for f in log.filters):
+        log.addFilter(_NotDuringAnInterrupt())
 
 
 def interrupt_of(exc: BaseException) -> KeyboardInterrupt | None:

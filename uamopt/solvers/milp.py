@@ -54,10 +54,12 @@ from pyomo.contrib.solver.common.factory import SolverFactory
 from pyomo.contrib.solver.common.results import SolutionStatus, TerminationCondition
 
 from uamopt.errors import UamoptError
-from uamopt.interrupts import stopping
+from uamopt.interrupts import quiet_on_interrupt, stopping
 from uamopt.schedule.flights import TIME_TOL_S
 from uamopt.schedule.model import Schedule, SchedulingProblem, make_schedule
 from uamopt.solvers.deadline import interrupt_at
+
+quiet_on_interrupt("pyomo.core")  # Ctrl-C while a model is built: no "ERROR: Constructing component" line
 
 SOLVER_NAME = "highs"  # Pyomo 6.10.x name of the HiGHS interface (newer upstream: "highs_persistent")
 
