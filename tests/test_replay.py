@@ -192,3 +192,60 @@ def test_paper_case_every_verified_schedule_replays_with_no_loss_of_separation(s
     result = replay(folder)
     assert result.los_count == 0 and not result.over_budget
     print(f"{solver}: {len(result.flights)} flights, {result.seconds}")
+
+
+def _children(pid: int, marker: str) -> list[int]:
+    """The pids of live processes whose parent is ``pid`` and whose command line holds ``marker``."""
+    found = []
+    for proc in Path("/proc").iterdir():
+        if not proc.name.isdigit():
+            continue
+        try:
+            stat = (proc / "stat").read_text()
+            cmdline = (proc / "cmdline").read_bytes().replace(b"\0", b" ").decode()
+        except OSError:
+            continue
+        fields = stat.rsplit(")", 1)[1].split()
+        if int(fields[1]) == pid and marker in cmdline and fields[0] != "Z":
+            found.append(int(proc.name))
+    return found
+
+
+def _alive(pid: int) -> bool:
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except OSError:
+        return False
+    return state != "Z"
+
+
+@pytest.mark.skipif(not Path("/proc/self/stat").is_file(), reason="reads the process table from /proc (Linux)")
+def test_sigkill_of_the_replay_ends_its_bluesky_worker(paper_schedule_dir, tmp_path):
+    """SIGKILL runs no clean-up in ``uamopt replay``: its ``uamopt.sim.worker`` child ran on alone
+    (issue 22). The worker now follows its parent (PR_SET_PDEATHSIG, and a watch of its parent's pid)."""
+    import signal
+    import time
+
+    folder = tmp_path / "sched"
+    shutil.copytree(paper_schedule_dir, folder)
+    parent = subprocess.Popen([sys.executable, "-m", "uamopt", "replay", str(folder)], stdout=subprocess.DEVNULL,
+                              stderr=subprocess.DEVNULL)
+    try:
+        for _ in range(600):  # the worker starts after the export: wait for it
+            workers = _children(parent.pid, "uamopt.sim.worker")
+            if workers or parent.poll() is not None:
+                break
+            time.sleep(0.1)
+        assert workers, "the replay never started its worker"
+        time.sleep(8.0)  # past BlueSky's start-up (which prints, and would die of the closed pipe): stepping, silent
+        assert _alive(workers[0])
+        parent.send_signal(signal.SIGKILL)
+        parent.wait()
+        for _ in range(100):
+            if not _alive(workers[0]):
+                break
+            time.sleep(0.1)
+        assert not _alive(workers[0]), "the worker outlived its parent by 10 s"
+    finally:
+        if parent.poll() is None:
+            parent.kill()

@@ -116,7 +116,7 @@ def _run_worker(scn: Path, until_s: float) -> tuple[dict, dict]:
     with tempfile.TemporaryDirectory(prefix="uamopt-replay-") as tmp:
         raw = Path(tmp) / "raw.npz"
         cmd = [sys.executable, "-m", "uamopt.sim.worker", str(scn), str(raw), "--workdir", str(_workdir()),
-               "--until", repr(until_s)]
+               "--until", repr(until_s), "--parent", str(os.getpid())]  # the worker ends with us, even on SIGKILL
         done = subprocess.run(cmd, capture_output=True, text=True, check=False)
         if done.returncode != 0 or not raw.is_file():
             last = (done.stderr.strip().splitlines() or ["no output"])[-1]

@@ -1,6 +1,6 @@
 """Run one BlueSky scenario headless in fast time and record the traffic (a subprocess of the replay).
 
-``python -m uamopt.sim.worker SCN OUT.npz --workdir DIR --until SECONDS``
+``python -m uamopt.sim.worker SCN OUT.npz --workdir DIR --until SECONDS [--parent PID]``
 
 BlueSky keeps global state, so :func:`uamopt.sim.replay.replay` runs each scenario in a fresh
 process of this module. It initialises BlueSky without networking (``detached=True``, never
@@ -82,6 +82,30 @@ def run(scn: str, out: str, workdir: str, until_s: float) -> dict:
     return meta
 
 
+def follow_parent(parent: int) -> None:
+    """End this worker when the replay that started it ends, even by SIGKILL (which runs no
+    clean-up in the parent: the worker ran on alone). Linux: the kernel sends SIGKILL to us when the
+    parent dies (``prctl(PR_SET_PDEATHSIG)``); elsewhere, and as a check that the parent did not
+    die before that call, a daemon thread watches the parent's pid every 0.2 s."""
+    import os
+    import threading
+
+    with contextlib.suppress(Exception):  # not Linux, or no libc: the thread below does it
+        import ctypes
+        import signal
+
+        ctypes.CDLL(None, use_errno=True).prctl(1, int(signal.SIGKILL), 0, 0, 0)  # 1 = PR_SET_PDEATHSIG
+
+    def watch() -> None:
+        while os.getppid() == parent:
+            time.sleep(0.2)
+        os._exit(1)
+
+    if os.getppid() != parent:
+        os._exit(1)
+    threading.Thread(target=watch, name="uamopt-parent-watch", daemon=True).start()
+
+
 def _version() -> str:
     from importlib.metadata import PackageNotFoundError, version
 
@@ -97,7 +121,10 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("out")
     parser.add_argument("--workdir", required=True)
     parser.add_argument("--until", type=float, required=True, help="stop at this clock time, s")
+    parser.add_argument("--parent", type=int, help="the replay's pid: end when it ends")
     args = parser.parse_args(argv)
+    if args.parent:
+        follow_parent(args.parent)
     meta = run(args.scn, args.out, args.workdir, args.until)
     print(json.dumps({k: meta[k] for k in ("steps", "wall_s", "end_s")}))
     return 0
