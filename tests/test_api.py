@@ -41,7 +41,8 @@ def test_stages_and_frames(stages):
     table2 = plan.to_frame()
     assert list(table2.index) == ["shortest", "initial", "equivalent", "optimal"]
     start, end = plan.stages["optimal"].waypoints[[0, -1]]
-    np.testing.assert_allclose(start, (300, 300, 120)) and np.testing.assert_allclose(end, (2220, 4220, 120))
+    np.testing.assert_allclose(start, (300, 300, 120))  # V1 at cruise altitude (Table B.3's vertiports)
+    np.testing.assert_allclose(end, (2220, 4220, 120))  # V4 (was joined to the line above by `and`: never ran)
     assert (table2["length_m"] >= 4365.0 - 1e-6).all()  # never shorter than the straight line V1-V4
     routes = network.to_frame()
     assert len(routes) == 20 and set(routes["origin"]) == {"V1", "V2", "V3", "V4", "V5"}
