@@ -152,7 +152,7 @@ def _run(spec: SweepSpec, folder: ResultsFolder, todo: list, have: set, client, 
         case, solvers, seeds = futures.pop(future)
         try:
             frame = _rows(case, future.result(), have, spec.stage)
-            folder.write_part(case.id, frame)
+            folder.write_part(case.id, frame, remaining=len(futures))  # a full disk: UamoptError, the parts saved kept
         except UamoptError:
             raise
         except Exception as exc:  # noqa: BLE001 - the cluster lost the task: report it, do not save it
@@ -186,7 +186,14 @@ def sweep(path, out=None, scheduler: str | None = None, workers: int | None = No
     ------
     UamoptError
         Bad sweep file, unreachable scheduler, a results folder that is not this sweep's or is
-        corrupt; raised before anything runs or is written.
+        corrupt; raised before anything runs or is written. A full disk or file-size limit
+        during a write (the cases saved before it are kept; a re-run computes the rest).
+
+    Warns
+    -----
+    SetAsideWarning
+        A part of the results folder broke the schema (uamopt/experiments/store.py) and was
+        renamed ``NAME.parquet.set-aside``; its case is recomputed.
     """
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
         raise UamoptError(f"--workers must be a whole number ≥ 1, got {workers!r}", "--workers", "give a number of worker processes")
@@ -207,15 +214,15 @@ def sweep(path, out=None, scheduler: str | None = None, workers: int | None = No
 
 
 def _sweep(spec: SweepSpec, folder: ResultsFolder, scheduler, workers):
-    done = folder.check(spec)
+    done, broken = folder.check(spec)
     todo, have = _todo(spec, done)
-    unsaved, stats = [], {"cases": len(spec.cases), "run": len(todo), "errors": 0}
+    unsaved, stats = [], {"cases": len(spec.cases), "run": len(todo), "errors": 0, "set_aside": []}
     if todo:
         scratch = tempfile.mkdtemp(prefix="uamopt-dask-")  # the workers' scratch space, removed afterwards
         try:
             client, cluster = connect(scheduler, workers, len(todo), scratch)
             try:
-                folder.start(spec)
+                stats["set_aside"] = folder.start(spec, broken)
                 with Progress(len(todo), f"sweep {spec.name}", "cases") as progress:
                     unsaved, stats["errors"] = _run(spec, folder, todo, have, client, progress)
             finally:
@@ -225,8 +232,8 @@ def _sweep(spec: SweepSpec, folder: ResultsFolder, scheduler, workers):
         finally:
             shutil.rmtree(scratch, ignore_errors=True)
     else:
-        folder.start(spec)
-    table = results_table(spec, [folder.check(spec)] + unsaved)
+        stats["set_aside"] = folder.start(spec, broken)
+    table = results_table(spec, [folder.read_parts(spec.stage)[0]] + unsaved)
     folder.write_results(table)
     if spec.figure:
         from uamopt.experiments.figures import save_sweep_figure

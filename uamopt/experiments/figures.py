@@ -23,6 +23,7 @@ that varies (see :func:`plot_sweep`).
 
 from __future__ import annotations
 
+import io
 import math
 import re
 from pathlib import Path
@@ -373,5 +374,7 @@ def save_sweep_figure(table, spec, path: str | Path) -> Path:
 
     fig = plot_sweep(table, spec.figure)
     fig.suptitle(f"{spec.name}{' (small)' if spec.small else ''}: {len(spec.cases)} cases", fontsize=10)
-    atomic_write(Path(path), lambda p: fig.savefig(p, format="png", dpi=DPI))
+    buffer = io.BytesIO()  # drawn in memory: a full disk's error then knows the size needed
+    fig.savefig(buffer, format="png", dpi=DPI)
+    atomic_write(Path(path), buffer.getvalue())
     return Path(path)

@@ -18,13 +18,17 @@
     "schedule.flights" = [60, 120]
 
 Everything is validated here, before any case runs: unknown keys (of the file and of the
-scenario), an empty grid, every case's scenario (:func:`load_sweep` builds each one), the solver
-profiles. A case's id is a hash of all its overrides, fixed and swept, so it is stable across runs
-and machines.
+scenario), the types of the tables and values (a TOML date or time is no value of any scenario
+key), ``[small]`` whether or not ``--small`` is given, an empty grid, the number of cases (at most
+``max_cases``, default :data:`MAX_CASES`, counted before any case is built), every case's
+scenario (:func:`load_sweep` builds each one), the solver profiles and seeds (0 to 2³¹ − 1, the
+solvers' 32-bit seeds). A case's id is a hash of all its overrides, fixed and swept, so it is
+stable across runs and machines.
 """
 
 from __future__ import annotations
 
+import datetime
 import hashlib
 import itertools
 import json
@@ -37,8 +41,12 @@ from typing import Any
 from uamopt.errors import ScenarioError, UamoptError
 
 STAGES = ("risk", "plan", "network", "schedule")
-FILE_KEYS = {"base", "stage", "solvers", "seeds", "time_limit_s", "figure", "name", "description", "set", "grid", "small"}
+FILE_KEYS = {"base", "stage", "solvers", "seeds", "time_limit_s", "figure", "name", "description", "set", "grid", "small",
+             "max_cases"}
 SMALL_KEYS = {"solvers", "seeds", "time_limit_s", "set", "grid"}
+#: the most cases a sweep file may have unless its ``max_cases`` says otherwise: every case's
+#: scenario is built (and checked) before anything runs, some milliseconds each
+MAX_CASES = 10_000
 
 
 @dataclass(frozen=True)
@@ -118,15 +126,51 @@ def _profile_text(profile) -> str:
 
 
 def _flatten(table: dict, prefix: str = "") -> dict:
-    """``{"a": {"b": 1}}`` and ``{"a.b": 1}`` both give ``{"a.b": 1}`` (quoted or bare dotted keys)."""
+    """``{"a": {"b": 1}}`` and ``{"a.b": 1}`` both give ``{"a.b": 1}`` (quoted or bare dotted keys).
+    Iterative: a key dotted thousands of levels deep is no RecursionError."""
     out: dict = {}
-    for key, value in table.items():
-        name = f"{prefix}{key}"
-        if isinstance(value, dict):
-            out.update(_flatten(value, f"{name}."))
+    stack = [(prefix, iter(table.items()))]
+    while stack:
+        name, items = stack[-1]
+        for key, value in items:
+            if isinstance(value, dict):
+                stack.append((f"{name}{key}.", iter(value.items())))
+                break
+            out[f"{name}{key}"] = value
         else:
-            out[name] = value
+            stack.pop()
     return out
+
+
+def _table(raw: dict, key: str, where: str, label: str | None = None) -> dict:
+    """``raw[key]`` (a TOML table, default empty) flattened; refused when it is not a table or
+    holds a date or time (no scenario key takes one)."""
+    label = label or key
+    value = raw.get(key, {})
+    if not isinstance(value, dict):
+        raise ScenarioError(f"[{label}] must be a table, got {value!r}"[:200], where,
+                            f'write it as a table, e.g. [{label}] then "schedule.aircraft" = ' + ("[10, 20]" if "grid" in label else "10"))
+    flat = _flatten(value)
+    for name, item in flat.items():
+        bad = _date_or_time(item)
+        if bad is not None:
+            raise ScenarioError(f"[{label}] \"{name}\" holds a TOML date or time ({bad.isoformat()}), not a number", where,
+                                "write the number (or the value) the scenario key takes")
+    return flat
+
+
+def _date_or_time(value: Any):
+    """The first TOML date, time or date-time in ``value`` (lists and inline tables included), else None."""
+    stack = [value]
+    while stack:
+        item = stack.pop()
+        if isinstance(item, (datetime.date, datetime.time)):  # datetime.datetime is a date
+            return item
+        if isinstance(item, list):
+            stack.extend(item)
+        elif isinstance(item, dict):
+            stack.extend(item.values())
+    return None
 
 
 def _read(path: Path) -> dict:
@@ -145,29 +189,76 @@ def _read(path: Path) -> dict:
                             "check that the file is readable") from None
 
 
-def _apply_small(raw: dict, where: str) -> dict:
+def _check_small(raw: dict, where: str) -> None:
+    """``[small]``'s shape, whether or not --small is given: a table of known keys of the right
+    types (its cases are built only with --small)."""
     small = raw.get("small", {})
     if not isinstance(small, dict):
-        raise ScenarioError("[small] must be a table", where, f"use keys among {', '.join(sorted(SMALL_KEYS))}")
+        raise ScenarioError(f"[small] must be a table, got {small!r}"[:200], where,
+                            f"write it as a table [small] of keys among {', '.join(sorted(SMALL_KEYS))}")
     unknown = sorted(set(small) - SMALL_KEYS)
     if unknown:
         raise ScenarioError(f"unknown key 'small.{unknown[0]}'", where, f"[small] takes {', '.join(sorted(SMALL_KEYS))}")
+    for key in ("set", "grid"):
+        _table(small, key, where, f"small.{key}")
+    if "seeds" in small:
+        _seeds(small["seeds"], where, "small.seeds")
+    if "time_limit_s" in small:
+        _time_limit(small["time_limit_s"], where, "small.time_limit_s")
+    solvers = small.get("solvers", ["greedy"])
+    if not isinstance(solvers, list) or not solvers or not all(isinstance(s, str) for s in solvers):
+        raise ScenarioError(f"small.solvers must be a non-empty list of profile names, got {solvers!r}"[:200], where,
+                            'write e.g. solvers = ["greedy"]')
+
+
+def _apply_small(raw: dict, where: str) -> dict:
+    small = raw.get("small", {})
     out = dict(raw)
     for key in ("solvers", "seeds", "time_limit_s"):
         if key in small:
             out[key] = small[key]
     for key in ("set", "grid"):
         if key in small:
-            out[key] = {**_flatten(raw.get(key, {})), **_flatten(small[key])}
+            out[key] = {**_table(raw, key, where), **_table(small, key, where, f"small.{key}")}
     return out
 
 
-def _seeds(raw: Any, where: str) -> tuple[int, ...]:
-    if not isinstance(raw, list) or not raw or not all(isinstance(s, int) and not isinstance(s, bool) and s >= 0 for s in raw):
-        raise ScenarioError(f"seeds must be a non-empty list of integers ≥ 0, got {raw!r}", where, "write e.g. seeds = [0, 1, 2]")
+def _time_limit(value: Any, where: str, key: str = "time_limit_s") -> float | None:
+    if value is not None and (isinstance(value, bool) or not isinstance(value, (int, float)) or not value > 0
+                              or not math.isfinite(value)):
+        raise ScenarioError(f"{key} must be a positive number, got {value!r}", where, "give seconds, e.g. 30.0")
+    return value
+
+
+def _seeds(raw: Any, where: str, key: str = "seeds") -> tuple[int, ...]:
+    """Solver seeds: whole numbers 0 to SEED_MAX (2³¹ − 1: HiGHS and CP-SAT seeds are 32-bit, as a
+    profile's ``seed`` is)."""
+    from uamopt.solvers.options import SEED_MAX
+
+    if not isinstance(raw, list) or not raw or not all(isinstance(s, int) and not isinstance(s, bool) and 0 <= s <= SEED_MAX
+                                                       for s in raw):
+        raise ScenarioError(f"{key} must be a non-empty list of integers from 0 to {SEED_MAX}, got {raw!r}"[:300], where,
+                            "write e.g. seeds = [0, 1, 2] (solver seeds are 32-bit)")
     if len(set(raw)) != len(raw):
-        raise ScenarioError(f"seeds repeat a value: {raw!r}", where, "list each seed once")
+        raise ScenarioError(f"{key} repeat a value: {raw!r}"[:300], where, "list each seed once")
     return tuple(raw)
+
+
+def _max_cases(raw: dict, where: str) -> int:
+    limit = raw.get("max_cases", MAX_CASES)
+    if isinstance(limit, bool) or not isinstance(limit, int) or limit < 1:
+        raise ScenarioError(f"max_cases must be a whole number ≥ 1, got {limit!r}", where,
+                            f"give the most cases the sweep may have, e.g. max_cases = {MAX_CASES}")
+    return limit
+
+
+def _check_size(grid: dict, limit: int, rows_per_case: int, where: str) -> None:
+    """Refuse a grid of more than ``limit`` cases from the lengths of its lists, before any is built."""
+    cases = math.prod(len(v) for v in grid.values())
+    if cases > limit:
+        rows = f" ({cases * rows_per_case:,} rows)" if rows_per_case > 1 else ""
+        raise ScenarioError(f"the grid has {cases:,} cases{rows}, more than the limit of {limit:,} cases", f"{where} [grid]",
+                            f"sweep fewer values, or raise the limit in the file (max_cases = {cases}) if you mean it")
 
 
 def _profiles(raw: Any, base_dir: Path, time_limit_s: float | None, where: str) -> tuple:
@@ -224,19 +315,22 @@ def load_sweep(path: str | Path, small: bool = False) -> SweepSpec:
     unknown = sorted(set(raw) - FILE_KEYS)
     if unknown:
         raise ScenarioError(f"unknown key '{unknown[0]}'", where, f"a sweep file takes {', '.join(sorted(FILE_KEYS))}")
+    _check_small(raw, where)
+    limit = _max_cases(raw, where)
     if small:
         if "small" not in raw:
             raise ScenarioError("the sweep file has no [small] table", where, "add [small] overrides or drop --small")
         raw = _apply_small(raw, where)
+    name = raw.get("name", path.stem)
+    if not isinstance(name, str):
+        raise ScenarioError(f"name must be a string, got {name!r}"[:200], where, 'write e.g. name = "speed"')
     if not isinstance(raw.get("base"), str):
         raise ScenarioError("missing key 'base'", where, 'name the base scenario, e.g. base = "../paper_case.toml"')
     base = (path.parent / raw["base"]).resolve()
     stage = raw.get("stage", "schedule")
     if stage not in STAGES:
         raise ScenarioError(f"unknown stage {stage!r}", where, f"use one of {', '.join(STAGES)}")
-    time_limit = raw.get("time_limit_s")
-    if time_limit is not None and (isinstance(time_limit, bool) or not isinstance(time_limit, (int, float)) or not time_limit > 0):
-        raise ScenarioError(f"time_limit_s must be a positive number, got {time_limit!r}", where, "give seconds, e.g. 30.0")
+    time_limit = _time_limit(raw.get("time_limit_s"), where)
     if stage == "schedule":
         solvers = _profiles(raw.get("solvers", ["greedy"]), path.parent, None if time_limit is None else float(time_limit), where)
         seeds = _seeds(raw.get("seeds", [0]), where)
@@ -245,17 +339,21 @@ def load_sweep(path: str | Path, small: bool = False) -> SweepSpec:
             if key in raw:
                 raise ScenarioError(f"'{key}' applies to stage = \"schedule\" only", where, "remove it or set stage = \"schedule\"")
         solvers, seeds = (), ()
-    fixed = _flatten(raw.get("set", {}))
-    grid = _flatten(raw.get("grid", {}))
+    fixed = _table(raw, "set", where)
+    grid = _table(raw, "grid", where)
     if not grid:
         raise ScenarioError("empty grid: no [grid] lists", where, 'add a [grid] table, e.g. "schedule.flights" = [60, 120]')
     for key, values in grid.items():
-        if not isinstance(values, list) or not values:
+        if not isinstance(values, list):
+            raise ScenarioError(f"[grid] \"{key}\" must be a list of values, got {values!r}"[:200], where,
+                                f"write \"{key}\" = [{toml_value(values)}] (a list, even of one value)")
+        if not values:
             raise ScenarioError(f"empty grid: [grid] \"{key}\" has no values", where, f"give \"{key}\" a non-empty list of values")
         if len({toml_value(v) for v in values}) != len(values):
             raise ScenarioError(f"[grid] \"{key}\" repeats a value", where, "list each value once")
         if key in fixed:
             raise ScenarioError(f"'{key}' is both in [set] and in [grid]", where, "keep it in one of them")
+    _check_size(grid, limit, max(1, len(solvers) * len(seeds)), where)
     figure = raw.get("figure")
     if figure is not None:
         from uamopt.experiments.figures import KEYS
@@ -275,5 +373,5 @@ def load_sweep(path: str | Path, small: bool = False) -> SweepSpec:
         overrides = tuple(fixed_overrides + [f"{k}={toml_value(v)}" for k, v in values.items()])
         shown = ", ".join(f"{k} = {toml_value(v)}" for k, v in values.items())
         cases.append(Case(index, case_id(overrides), values, overrides, _scenario(base, list(overrides), f"{where} case {shown}")))
-    return SweepSpec(path=path, name=str(raw.get("name", path.stem)), base=base, stage=stage, solvers=solvers, seeds=seeds,
+    return SweepSpec(path=path, name=name, base=base, stage=stage, solvers=solvers, seeds=seeds,
                      fixed=fixed, grid=grid, cases=tuple(cases), time_limit_s=time_limit, figure=figure, small=small)

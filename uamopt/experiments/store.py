@@ -9,16 +9,33 @@
 Every file is written to a temporary name in its own folder, flushed to disk and renamed over its
 final name (``os.replace`` is atomic), so a part either exists whole or not at all. Re-running a
 sweep reads the parts, runs only the rows they lack and rebuilds ``results.parquet``; nothing in
-the folder is ever deleted. A folder that is not a sweep's, holds another sweep, or has an
-unreadable file is refused before anything runs.
+the folder is ever deleted. A folder that is not a sweep's, holds another sweep, has an
+unreadable or malformed ``sweep.json``, or a ``parts`` that is no folder, is refused before
+anything runs.
+
+Every part is read through one schema (:func:`part_problem`): its name ``<case>-<k>.parquet``,
+the key columns, each known column's type, the ranges (seeds 0 to 2³¹ − 1, counts ≥ 0, shares in
+[0, 1], a known status), rows of its own case only and one row per case × solver × seed. A part
+that breaks it, and every part holding a row that conflicts with another part's row for the same
+case, solver and seed (which of them is right is unknown), is set aside: renamed
+``NAME.parquet.set-aside`` (``.set-aside-2``, ... when taken), never deleted, reported with a
+:class:`SetAsideWarning`, and its rows are recomputed. An identical copy of a row is read once.
+
+A full disk (ENOSPC, EDQUOT) or a file-size limit (EFBIG) during any write is one
+:class:`~uamopt.errors.UamoptError` naming the file, the space it needs and the space free; the
+temporary file is removed, every file written before it is kept.
 """
 
 from __future__ import annotations
 
+import errno
 import hashlib
 import json
 import os
+import re
+import shutil
 import tempfile
+import warnings
 from pathlib import Path
 
 from uamopt.errors import UamoptError
@@ -38,6 +55,18 @@ RISK = {"unsafe_share": "float64", "band_unsafe_share": "float64", "cruise_unsaf
 SIZE = {"flights": "Int64", "aircraft": "Int64", "conflicting_pairs": "Int64"}
 TAIL = {"error": "str", "uamopt_version": "str"}
 TIMING = ("seconds",)
+KEYS = ("case", "solver", "seed", "status")
+SET_ASIDE = ".set-aside"
+PART_NAME = re.compile(r"([0-9a-f]{12})-[0-9a-f]{8}\.parquet")
+MANIFEST_MAX_BYTES = 16 * 2**20
+NO_SPACE = {errno.ENOSPC, errno.EDQUOT, errno.EFBIG}  # disk full, quota, file size limit
+COUNTS = ("operated", "cancelled", "flights", "aircraft", "conflicting_pairs", "n_waypoints")
+SHARES = ("unsafe_share", "band_unsafe_share", "cruise_unsafe_share")
+NOT_NEGATIVE = ("seconds", "gap", "length_m", "cruise_mean_risk")
+
+
+class SetAsideWarning(UserWarning):
+    """A part of a results folder broke the schema and was renamed; its rows are recomputed."""
 
 
 def columns(stage: str) -> dict:
@@ -75,20 +104,80 @@ def version() -> str:
         return uamopt.__version__
 
 
-def atomic_write(path: Path, write) -> None:
-    """Call ``write(tmp_path)``, flush the file to disk and rename it over ``path``."""
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    os.close(fd)
-    umask = os.umask(0)
-    os.umask(umask)
-    os.chmod(tmp, 0o666 & ~umask)  # mkstemp's 0600 would make results private
+def size_text(n: float) -> str:
+    """A size in bytes as ``812 B``, ``16.2 KB``, ``3.1 MB``, ``1.5 GB`` (powers of 1024)."""
+    for unit in ("B", "KB", "MB", "GB"):
+        if n < 1024 or unit == "GB":
+            return f"{n:.0f} {unit}" if unit == "B" else f"{n:.1f} {unit}"
+        n /= 1024
+    raise AssertionError  # unreachable
+
+
+def out_of_space(exc: OSError, path: Path, size: int, need: int | None = None, where: str = "", keep: str = "",
+                 exact: bool = True) -> UamoptError:
+    """The one-line error of a write to ``path`` (``size`` bytes; ``exact`` False: the bytes
+    written when it stopped) that a full disk, a quota or a file-size limit stopped; ``need``: the
+    bytes still to write, this file included; ``keep``: what the user keeps (the end of the fix)."""
+    where = where or str(path.parent)
+    keep = keep or f"then run the command again ({path.name} was not written)"
+    if exc.errno == errno.EFBIG:
+        import resource
+
+        soft = resource.getrlimit(resource.RLIMIT_FSIZE)[0]
+        limit = (f"more than the file size limit of {size_text(soft)} (ulimit -f)" if soft != resource.RLIM_INFINITY
+                 else "more than the file system's largest file")
+        return UamoptError(f"cannot write {path}: File too large: it needs {'' if exact else 'more than '}{size_text(size)}, "
+                           f"{limit}", where,
+                           f"raise the limit (ulimit -f) or write to another disk, {keep}")
     try:
-        write(Path(tmp))
-        with open(tmp, "rb+") as fh:
-            os.fsync(fh.fileno())
+        free = f"{size_text(shutil.disk_usage(path.parent).free)} free"
+    except OSError:
+        free = "free space unknown"
+    need = max(need or 0, size)
+    amount = f"about {size_text(need)}" if exact or need > size else f"more than {size_text(size)}"
+    return UamoptError(f"cannot write {path}: {exc.strerror or 'No space left on device'}: needs {amount} to finish, {free}",
+                       where,
+                       f"free some space or write to another disk, {keep}")
+
+
+def atomic_write(path: Path, write, need: int | None = None, where: str = "", keep: str = "") -> None:
+    """Write ``write`` (bytes, or a callable ``write(tmp_path)``) to a temporary file beside
+    ``path``, flush it to disk and rename it over ``path``.
+
+    Raises
+    ------
+    UamoptError
+        The disk is full or the file too large (:func:`out_of_space`; ``need``, ``where`` and
+        ``keep`` go into its message); the temporary file is removed and ``path`` is as it was.
+    """
+    data = bytes(write) if isinstance(write, (bytes, bytearray, memoryview)) else None
+    tmp = None
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+        os.close(fd)
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)  # mkstemp's 0600 would make results private
+        if data is not None:
+            with open(tmp, "wb") as fh:
+                fh.write(data)
+                fh.flush()
+                os.fsync(fh.fileno())
+        else:
+            write(Path(tmp))
+            with open(tmp, "rb+") as fh:
+                os.fsync(fh.fileno())
         os.replace(tmp, path)
+    except OSError as exc:
+        size = len(data) if data is not None else _size_of(tmp)
+        if tmp is not None:
+            Path(tmp).unlink(missing_ok=True)
+        if exc.errno in NO_SPACE:
+            raise out_of_space(exc, path, size, need, where, keep, exact=data is not None) from None
+        raise
     except BaseException:
-        Path(tmp).unlink(missing_ok=True)
+        if tmp is not None:
+            Path(tmp).unlink(missing_ok=True)
         raise
     try:  # make the rename itself durable
         dfd = os.open(path.parent, os.O_RDONLY)
@@ -98,6 +187,102 @@ def atomic_write(path: Path, write) -> None:
             os.close(dfd)
     except OSError:
         pass
+
+
+def _size_of(path) -> int:
+    try:
+        return os.stat(path).st_size if path is not None else 0
+    except OSError:
+        return 0
+
+
+def _column_problem(series, dtype: str) -> str | None:
+    """Why ``series`` cannot be a column of ``dtype`` (None when it can); an all-empty column can."""
+    from pandas.api import types
+
+    values = series.dropna()
+    if len(values) == 0:
+        return None
+    if dtype == "str":
+        return None if all(isinstance(v, str) for v in values) else "is not text"
+    if types.is_bool_dtype(series) and dtype != "boolean":
+        return "is true/false, not a number"
+    if dtype == "Int64":
+        return None if types.is_integer_dtype(series) else "is not a whole number"
+    if dtype == "float64":
+        return None if types.is_numeric_dtype(series) else "is not a number"
+    if dtype == "boolean":
+        return None if types.is_bool_dtype(series) else "is not true or false"
+    raise AssertionError(dtype)
+
+
+def part_problem(frame, stage: str, name: str) -> str | None:
+    """Why the part ``name`` holding ``frame`` breaks the results schema of ``stage`` (None when
+    it does not): its name, the key columns, the type of each known column (others are ignored),
+    the ranges, rows of its own case only, one row per case × solver × seed."""
+    from uamopt.schedule.model import STATUSES
+    from uamopt.solvers.options import SEED_MAX
+
+    match = PART_NAME.fullmatch(name)
+    if match is None:
+        return "its name is not <case>-<k>.parquet"
+    if frame.columns.duplicated().any():
+        return "a column name repeats"
+    missing = [c for c in KEYS if c not in frame.columns]
+    if missing:
+        return f"it lacks the column {missing[0]}"
+    if len(frame) == 0:
+        return "it holds no rows"
+    for column, dtype in ({"case": "str"} | columns(stage)).items():
+        problem = _column_problem(frame[column], dtype) if column in frame.columns else None
+        if problem:
+            return f"{column} {problem}"
+    if frame["case"].isna().any() or (frame["case"] != match.group(1)).any():
+        return f"it holds rows of another case than {match.group(1)}"
+    solver, seed = frame["solver"], frame["seed"]
+    if stage == "schedule":
+        if solver.isna().any() or (solver == "").any():
+            return "a row has no solver"
+        if seed.isna().any() or not seed.between(0, SEED_MAX).all():
+            return f"seed is not a whole number from 0 to {SEED_MAX}"
+    elif solver.notna().any() or seed.notna().any():
+        return f"a row has a solver or seed, which stage {stage} has not"
+    status = frame["status"]
+    if status.isna().any() or not status.isin((*STATUSES, "ok")).all():
+        bad = status[~status.isin((*STATUSES, "ok"))].iloc[0]
+        return f"status {bad!r} is not one of {', '.join((*STATUSES, 'ok'))}"[:200]
+    for column in COUNTS + NOT_NEGATIVE:
+        if column in frame.columns and (frame[column].dropna() < 0).any():
+            return f"{column} is negative"
+    for column in SHARES:
+        if column in frame.columns and not frame[column].dropna().between(0.0, 1.0).all():
+            return f"{column} is not a share from 0 to 1"
+    keys = [row_key(c, s, d) for c, s, d in zip(frame["case"], solver, seed)]
+    if len(set(keys)) != len(keys):
+        return "it holds two rows for the same case, solver and seed"
+    return None
+
+
+def _manifest_problem(doc) -> str | None:
+    """Why ``doc`` (a parsed sweep.json) is not a manifest (None when it is one)."""
+    from uamopt.experiments.spec import STAGES
+
+    if not isinstance(doc, dict):
+        return "not a JSON object"
+    if type(doc.get("uamopt_sweep")) is not int or doc["uamopt_sweep"] != 1:
+        return "not a sweep manifest: uamopt_sweep is not 1"
+    for key in ("name", "base_sha256"):
+        if not isinstance(doc.get(key), str):
+            return f"{key} is not a string"
+    if doc.get("stage") not in STAGES:
+        return f"stage is not one of {', '.join(STAGES)}"
+    if not isinstance(doc.get("small"), bool):
+        return "small is not true or false"
+    for key in ("set", "solvers"):
+        table = doc.get(key)
+        if not isinstance(table, dict) or not all(isinstance(k, str) and isinstance(v, str) for k, v in table.items()):
+            return f"{key} is not an object of strings"
+    return None
 
 
 def row_key(case, solver, seed) -> tuple:
@@ -112,29 +297,52 @@ class ResultsFolder:
     def __init__(self, out: str | Path):
         self.out = Path(out)
         self.parts = self.out / PARTS
+        self._manifest: dict | None = None  # the folder's validated sweep.json, read by check
 
     def _corrupt(self, what: str, path: Path, fix: str):
         return UamoptError(f"corrupt results folder: {what}", str(path), fix)
 
-    def check(self, spec):
-        """Validate the folder against ``spec`` and return the rows already done (a DataFrame, or
-        None when there are none). Writes nothing."""
-        import pandas as pd
+    def _read_manifest(self, manifest: Path) -> dict:
+        try:
+            if manifest.stat().st_size > MANIFEST_MAX_BYTES:
+                raise ValueError(f"larger than {size_text(MANIFEST_MAX_BYTES)}")
+            doc = json.loads(manifest.read_text(encoding="utf-8"))
+        except RecursionError:
+            problem = "nested too deeply"
+        except (ValueError, UnicodeDecodeError) as exc:
+            problem = " ".join(str(exc).split())[:200]
+        except OSError as exc:
+            problem = exc.strerror or type(exc).__name__
+        else:
+            problem = _manifest_problem(doc)
+            if problem:
+                raise self._corrupt(f"{MANIFEST} is malformed ({problem})", manifest,
+                                    "restore it, or use a new --out; nothing was changed")
+        if problem:
+            raise self._corrupt(f"{MANIFEST} is unreadable ({problem})", manifest,
+                                "restore it, or use a new --out; nothing was changed")
+        return doc
 
+    def check(self, spec):
+        """Validate the folder against ``spec`` and return ``(rows, broken)``: the rows already
+        done (a DataFrame, or None when there are none) and the parts that break the schema,
+        ``[(path, why), ...]``, which :meth:`start` sets aside. Writes nothing.
+
+        Raises
+        ------
+        UamoptError
+            ``out`` is a file, a folder that is not a sweep's or is another sweep's, its
+            sweep.json is unreadable or malformed, its ``parts`` is not a folder.
+        """
         if self.out.exists() and not self.out.is_dir():
             raise UamoptError(f"output path is a file: {self.out}", "--out", "give a folder path")
         if not self.out.exists() or not [p for p in self.out.iterdir() if not p.name.startswith(".")]:
-            return None
+            return None, []
         manifest = self.out / MANIFEST
         if not manifest.is_file():
             raise UamoptError(f"{self.out} is not a sweep results folder (no {MANIFEST})", "--out",
                               "give an empty or new folder; nothing was changed")
-        try:
-            old = json.loads(manifest.read_text(encoding="utf-8"))
-            if not isinstance(old, dict) or old.get("uamopt_sweep") != 1:
-                raise ValueError("not a sweep manifest")
-        except (ValueError, UnicodeDecodeError) as exc:
-            raise self._corrupt(f"{MANIFEST} is unreadable ({exc})", manifest, "restore it, or use a new --out") from None
+        old = self._read_manifest(manifest)
         new = spec.manifest()
         for key, label in (("base_sha256", "the base scenario"), ("stage", "the stage"), ("small", "--small"),
                            ("set", "the [set] overrides")):
@@ -142,40 +350,122 @@ class ResultsFolder:
                 raise UamoptError(f"the results folder holds another sweep ({label} differs)", str(self.out),
                                   "use a new --out for this sweep; nothing was changed")
         for name, text in new["solvers"].items():
-            if name in old.get("solvers", {}) and old["solvers"][name] != text:
+            if name in old["solvers"] and old["solvers"][name] != text:
                 raise UamoptError(f"the results folder holds solver profile '{name}' with other settings", str(self.out),
                                   "use a new --out, or give the changed profile another name")
-        frames = []
+        if os.path.lexists(self.parts) and not self.parts.is_dir():
+            raise self._corrupt(f"{PARTS} is not a folder", self.parts,
+                                f"move that file away (the finished cases are kept in the folder {PARTS}); nothing was changed")
+        self._manifest = old
+        return self.read_parts(spec.stage)
+
+    def read_parts(self, stage: str):
+        """``(rows, broken)`` of the parts (module docstring): the rows of every part that keeps
+        the schema, typed, each (case, solver, seed) once, and ``[(path, why), ...]`` of the others."""
+        import pandas as pd
+
+        cols = {"case": "str"} | columns(stage)
+        good, broken = [], []
         for part in sorted(self.parts.glob("*.parquet")) if self.parts.is_dir() else []:
+            if not part.is_file():
+                broken.append((part, "not a file"))
+                continue
             try:
                 frame = pd.read_parquet(part)
             except Exception as exc:  # noqa: BLE001 - any unreadable file
-                raise self._corrupt(f"part {part.name} is unreadable ({type(exc).__name__})", part,
-                                    "delete that file to recompute its case; nothing was changed") from None
-            if not {"case", "solver", "seed", "status"} <= set(frame.columns):
-                raise self._corrupt(f"part {part.name} lacks the key columns", part,
-                                    "delete that file to recompute its case; nothing was changed")
-            frames.append(frame)
-        return pd.concat(frames, ignore_index=True) if frames else None
+                broken.append((part, f"unreadable: {type(exc).__name__}"))
+                continue
+            problem = part_problem(frame, stage, part.name)
+            if problem:
+                broken.append((part, problem))
+            else:
+                good.append((part, typed_frame(frame.to_dict("records"), cols)))
+        seen: dict = {}  # row key -> (part, row values)
+        conflicts: dict = {}  # part -> why
+        for part, frame in good:
+            values = frame.astype(object).where(frame.notna(), None)
+            for row in values.itertuples(index=False):
+                key = row_key(row.case, row.solver, row.seed)
+                if key not in seen:
+                    seen[key] = (part, tuple(row))
+                elif seen[key][1] != tuple(row):
+                    other = seen[key][0]
+                    label = f"case {key[0]}" + (f", solver {key[1]}, seed {key[2]}" if key[1] is not None else "")
+                    conflicts.setdefault(part, f"its row for {label} differs from the one in part {other.name}")
+                    conflicts.setdefault(other, f"its row for {label} differs from the one in part {part.name}")
+        broken += list(conflicts.items())
+        frames = [f for p, f in good if p not in conflicts]
+        if not frames:
+            return None, broken
+        rows = pd.concat(frames, ignore_index=True)
+        keys = [row_key(c, s, d) for c, s, d in zip(rows["case"], rows["solver"], rows["seed"])]
+        return rows[~pd.Series(keys).duplicated().to_numpy()].reset_index(drop=True), broken  # identical copies once
 
-    def start(self, spec) -> None:
-        """Create the folder and write (or extend with new solvers) its manifest."""
-        self.parts.mkdir(parents=True, exist_ok=True)
-        manifest = self.out / MANIFEST
+    def set_aside(self, broken: list, cases=None) -> list[str]:
+        """Rename each broken part to ``NAME.set-aside`` (or ``-2``, ``-3``, ...: never over a
+        file) and warn (``cases``: the ids of the sweep's cases, which are recomputed); returns the
+        new paths."""
+        moved = []
+        for part, why in broken:
+            target, n = part.with_name(part.name + SET_ASIDE), 2
+            while os.path.lexists(target):
+                target, n = part.with_name(f"{part.name}{SET_ASIDE}-{n}"), n + 1
+            try:
+                os.rename(part, target)
+            except OSError as exc:
+                raise UamoptError(f"cannot set aside the broken part {part} ({why}): {exc.strerror or exc}", str(self.out),
+                                  "check the folder's permissions, or move that file away yourself") from None
+            match = PART_NAME.fullmatch(part.name)
+            then = ("its case is recomputed" if cases is None or (match and match.group(1) in cases)
+                    else "its case is not one of this sweep")
+            warnings.warn(f"part {part} breaks the results schema ({why}): set aside as {target.name}, {then}",
+                          SetAsideWarning, stacklevel=2)
+            moved.append(str(target))
+        return moved
+
+    def start(self, spec, broken: list = ()) -> list[str]:
+        """Create the folder, set the ``broken`` parts aside and write (or extend with new
+        solvers) its manifest; returns the set-aside paths."""
+        try:
+            self.parts.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            if exc.errno in NO_SPACE:
+                raise out_of_space(exc, self.parts, 0, where=str(self.out), keep=self._keep()) from None
+            raise UamoptError(f"cannot create {self.parts}: {exc.strerror or exc}", str(self.out),
+                              "check the folder's path and permissions") from None
+        moved = self.set_aside(list(broken), {c.id for c in spec.cases})
         doc = spec.manifest()
-        if manifest.is_file():
-            old = json.loads(manifest.read_text(encoding="utf-8"))
-            doc["solvers"] = {**old.get("solvers", {}), **doc["solvers"]}
-        atomic_write(manifest, lambda p: p.write_text(json.dumps(doc, indent=2) + "\n", encoding="utf-8"))
+        if self._manifest is not None:
+            doc["solvers"] = {**self._manifest["solvers"], **doc["solvers"]}
+        atomic_write(self.out / MANIFEST, (json.dumps(doc, indent=2) + "\n").encode("utf-8"), where=str(self.out),
+                     keep=self._keep())
+        self._manifest = doc
+        return moved
 
-    def write_part(self, case_id: str, frame) -> Path:
-        """Save one finished case's rows as a new part (a name no other part has)."""
+    def _parts_bytes(self) -> int:
+        return sum(_size_of(p) for p in self.parts.glob("*.parquet"))
+
+    def _keep(self) -> str:
+        """The end of a full disk's fix: what is kept, what a re-run does."""
+        saved = len(list(self.parts.glob("*.parquet"))) if self.parts.is_dir() else 0
+        if saved == 0:
+            return "then re-run the same command (no case had been saved yet)"
+        return (f"then re-run the same command: the {saved} finished case{'s' if saved != 1 else ''} saved in {PARTS}/ "
+                f"{'are' if saved != 1 else 'is'} kept and only what is missing is computed")
+
+    def write_part(self, case_id: str, frame, remaining: int = 0) -> Path:
+        """Save one finished case's rows as a new part (a name no other part has); ``remaining``:
+        the cases still to save after it (for the space a full disk's error says is needed)."""
         keys = ",".join(f"{s}:{d}" for s, d in zip(frame["solver"].astype(object), frame["seed"].astype(object)))
         path = self.parts / f"{case_id}-{hashlib.sha1(keys.encode()).hexdigest()[:8]}.parquet"
-        atomic_write(path, lambda p: frame.to_parquet(p, index=False))
+        data = frame.to_parquet(None, index=False)
+        parts = len(data) * (1 + remaining)
+        # this part, the parts after it, and results.parquet, at most about the size of all the parts
+        need = parts + self._parts_bytes() + parts
+        atomic_write(path, data, need=need, where=str(self.out), keep=self._keep())
         return path
 
     def write_results(self, frame) -> Path:
         path = self.out / RESULTS
-        atomic_write(path, lambda p: frame.to_parquet(p, index=False))
+        atomic_write(path, frame.to_parquet(None, index=False), where=str(self.out), keep=self._keep())
         return path
