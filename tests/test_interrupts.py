@@ -190,3 +190,24 @@ def test_pyomo_does_not_log_an_interrupt_during_a_model_build(error, logged):
     name = error.split("(")[0]
     assert done.returncode == 0 and f"raised {name}" in done.stdout, (done.stdout, done.stderr)
     assert ("Constructing component" in done.stdout + done.stderr) is logged
+
+
+AT_DEADLINE = """import sys
+sys.path.insert(0, "tests/benchmarks")
+from bench_exact import ladder_problem
+import uamopt as ua
+from uamopt.solvers import SolverProfile
+schedule = ua.solve(ladder_problem(1000), SolverProfile("highs", time_limit_s=20.0, threads=1))
+print("status", schedule.status, schedule.extras.get("termination"))
+"""
+
+
+@pytest.mark.slow
+def test_highs_stopped_at_its_deadline_prints_no_pyomo_warning():
+    """HiGHS stopped by uamopt's deadline callback (deadline.py) made Pyomo print "WARNING: Received
+    unhandled status=<HighsModelStatus.kInterrupt: 17> from solver HiGHS." before every time-limit
+    result (seen in uamopt bench on airland9). The status is the time limit, with no warning."""
+    done = run(AT_DEADLINE, timeout=300)
+    assert done.returncode == 0, done.stderr
+    assert "status time_limit" in done.stdout, done.stdout
+    assert "unhandled" not in done.stdout + done.stderr, (done.stdout, done.stderr)

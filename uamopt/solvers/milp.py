@@ -61,6 +61,20 @@ from uamopt.solvers.deadline import interrupt_at
 
 quiet_on_interrupt("pyomo.core")  # Ctrl-C while a model is built: no "ERROR: Constructing component" line
 
+
+class _OurInterrupt(logging.Filter):
+    """Pyomo warns "Received unhandled status=<HighsModelStatus.kInterrupt: 17> from solver HiGHS"
+    whenever HiGHS stops by interrupt, and that is always ours: the deadline callback
+    (deadline.py, read as the time limit) or Ctrl-C (read as the interrupt)."""
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        return "kInterrupt" not in record.getMessage()
+
+
+_PYOMO_HIGHS_LOG = logging.getLogger("pyomo.contrib.solver.solvers.highs")
+if not any(isinstance(f, _OurInterrupt) for f in _PYOMO_HIGHS_LOG.filters):
+    _PYOMO_HIGHS_LOG.addFilter(_OurInterrupt())
+
 SOLVER_NAME = "highs"  # Pyomo 6.10.x name of the HiGHS interface (newer upstream: "highs_persistent")
 
 
@@ -484,9 +498,8 @@ def _start_only(problem: SchedulingProblem, profile, start, t0: float, why: str)
 
 def cancel(solver):
     """What stops Pyomo's HiGHS ``solver`` mid-solve (uamopt.interrupts.stopping): its highspy model,
-    which exists once the solve has begun. Pyomo's warning about the interrupted status is muted."""
+    which exists once the solve has begun (Pyomo's warning about the interrupted status: _OurInterrupt)."""
     def stop() -> None:
-        logging.getLogger(type(solver).__module__).setLevel(logging.ERROR)
         solver._solver_model.cancelSolve()
 
     return stop
