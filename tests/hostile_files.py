@@ -267,8 +267,81 @@ def write_npz_bomb(path: Path) -> None:
             archive.writestr(f"{name}.npy", small.getvalue())
 
 
+BIG = 10**400  # a JSON or TOML integer of 401 digits: float() of it overflows
+HUGE = "9" * 5000  # more digits than Python's int-string limit (4300): a ValueError while parsing
+
+
+def _huge(text: str, value: str) -> str:
+    """``text`` with the first occurrence of ``value`` replaced by a 5000-digit integer."""
+    assert value in text, value
+    return text.replace(value, HUGE, 1)
+
+
+def write_numbers(d: Path) -> None:
+    """Numbers out of every range (issue 22, item 6): 400-digit and 5000-digit integers, NaN, inf,
+    1e300 and 1e-300 in flights and network files, schedule folders, solver profiles and scenarios;
+    a symlink loop and a name holding a newline as --out."""
+    good = good_flights()
+
+    def first(key, value):
+        return lambda doc: doc["flights"][0].__setitem__(key, value)
+
+    for name, edit in {"departure_big": first("planned_departure_s", BIG), "speed_big": first("speed_mps", BIG),
+                       "delay_big": first("max_delay_s", BIG), "cell_big": lambda doc: doc.__setitem__("cell", [BIG, 250, 60]),
+                       "waypoint_big": first("waypoints", [[300, 300, BIG], [2220, 4220, 290]]),
+                       "id_newline": lambda doc: doc["flights"][0].update(id="F1\nerror: forged", speed_mps=0)}.items():
+        _json(d / f"flights_{name}.json", _tamper(good, edit))
+    (d / "flights_departure_huge.json").write_text(_huge(json.dumps(good), "0.0"), encoding="utf-8")
+    net = good_network()
+    for name, edit in {"cell_big": lambda doc: doc.__setitem__("cell", [BIG, 250, 60]),
+                       "waypoint_big": lambda doc: doc["routes"]["V1-V2"].__setitem__("waypoints", [[300, 300, BIG], [300, 4220, 290]]),
+                       "length_big": lambda doc: doc["routes"]["V1-V2"].__setitem__("length_m", BIG),
+                       "layer_inf": lambda doc: doc["routes"]["V1-V2"].__setitem__("layer_k", float("inf"))}.items():
+        _json(d / f"net_{name}.json", _tamper(net, edit))
+    # schedule folders read by export
+    for name, file, edit in (("departure_big", "flights.json", lambda doc: doc["flights"][0].__setitem__("planned_departure_s", BIG)),
+                             ("origin_big", "summary.json", lambda doc: doc["frame"].__setitem__("origin", [BIG, 0]))):
+        target = d / f"sched_{name}"
+        shutil.copytree(d / "good", target)
+        _json(target / file, _tamper(json.loads((target / file).read_text()), edit))
+    target = d / "sched_summary_huge"
+    shutil.copytree(d / "good", target)
+    (target / "summary.json").write_text(_huge((target / "summary.json").read_text(), "0.0"), encoding="utf-8")
+    # solver profiles
+    profiles = {"limit_big": f'solver = "greedy"\ntime_limit_s = {BIG}\n',
+                "limit_huge": f'solver = "greedy"\ntime_limit_s = {HUGE}\n',
+                "highs_gap_nan": 'solver = "highs"\ntime_limit_s = 2\n[options]\nmip_rel_gap = nan\n',
+                "highs_gap_inf": 'solver = "highs"\ntime_limit_s = 2\n[options]\nmip_rel_gap = inf\n',
+                "ga_population_inf": 'solver = "ga"\n[options]\npopulation = inf\n',
+                "ga_population_nan": 'solver = "ga"\n[options]\npopulation = nan\n',
+                "ga_population_1e8": 'solver = "ga"\n[options]\npopulation = 100000000\n',
+                "ga_t0_big": f'solver = "ga"\n[options]\nt0 = {BIG}\n',
+                "soa_points_big": f'solver = "soa"\n[options]\nmulti_points = {BIG}\n',
+                "greedy_step_big": f'solver = "greedy"\n[options]\nstep_s = {BIG}\n',
+                "timeindexed_step_tiny": 'solver = "timeindexed"\n[options]\nstep_s = 1e-300\n',
+                "timeindexed_gap_big": f'solver = "timeindexed"\n[options]\nmip_rel_gap = {BIG}\n',
+                "cpsat_unit_tiny": 'solver = "cpsat"\n[options]\ntime_unit_s = 1e-300\n'}
+    for name, text in profiles.items():
+        (d / f"profile_{name}.toml").write_text(text, encoding="utf-8")
+    # scenarios
+    paper = PAPER_CASE.read_text(encoding="utf-8")
+    (d / "seed_big.toml").write_text(paper.replace("seed = 7", f"seed = {BIG}"), encoding="utf-8")
+    (d / "seed_huge.toml").write_text(paper.replace("seed = 7", f"seed = {HUGE}"), encoding="utf-8")
+    # GeoJSON layers of the DSM city (write_rasters): a 400-digit and a NaN coordinate
+    square = [[UTM[0] + x, UTM[1] + y] for x, y in [(101, 261), (139, 261), (139, 299), (101, 299), (101, 261)]]
+    for name, value in (("big", BIG), ("nan", float("nan"))):
+        _json(d / f"nofly_{name}.geojson", _polygon([square[0], [value, square[1][1]], *square[2:]]))
+        (d / f"dsm_nofly_{name}.toml").write_text(f'name = "nofly_{name}"\n[grid]\ncell = [20.0, 20.0, 10.0]\n[city]\n'
+                                                  f'source = "dsm"\ndsm = "ok.tif"\nno_fly = "nofly_{name}.geojson"\n',
+                                                  encoding="utf-8")
+    # output paths: a symlink loop, a file whose name holds a newline
+    (d / "out_loop").symlink_to(d / "out_loop")
+    (d / "out_file\nerror: forged").write_text("a file, not a folder", encoding="utf-8")
+
+
 def write_all(d: Path) -> Path:
     d.mkdir(parents=True, exist_ok=True)
-    for write in (write_scenarios, write_profiles, write_networks, write_flights, write_rasters, write_folders):
+    for write in (write_scenarios, write_profiles, write_networks, write_flights, write_rasters, write_folders,
+                  write_numbers):
         write(d)
     return d

@@ -87,7 +87,7 @@ def test_solver_profile_overrides():
     profile = ua.solver_profile("soa", time_limit_s=5.0, seed=3, options={"generations": 7})
     assert (profile.time_limit_s, profile.seed, profile.options["generations"], profile.options["population"]) == \
         (5.0, 3, 7, 50)
-    with pytest.raises(ua.UamoptError, match="time_limit_s must be a positive number of seconds, got 0.0"):
+    with pytest.raises(ua.UamoptError, match=r"time_limit_s must be a number in \(0, 1e\+07\], got 0.0"):
         ua.solver_profile("greedy", time_limit_s=0.0)
 
 

@@ -130,7 +130,7 @@ CASES = [
     *[(f"network-{name.replace('_', '-')}", SCHED + f" --network {{d}}/net_{name}.json --out {{out}}", 2, fragment)
       for name, fragment in (
         ("one_point", "at least two finite"), ("zero_length", "zero length"), ("nan", "at least two finite"),
-        ("words", "could not convert"), ("far", "outside the grid"), ("below", "outside the grid"),
+        ("words", "got 'north'"), ("far", "outside the grid"), ("below", "outside the grid"),
         ("ground", "on or below the ground"), ("tower", "passes through a building"), ("no_routes", "non-empty"),
         ("routes_list", "non-empty"), ("bad_cell", "'cell' must be three positive"), ("tiny_cell", "more than the limit"),
         ("missing_route", "unknown route 'V1-V2'"), ("list", "non-empty"), ("truncated", "malformed network file"),
@@ -139,9 +139,9 @@ CASES = [
     *[(f"flights-{name.replace('_', '-')}", SCHED + f" --flights {{d}}/flights_{name}.json --out {{out}}", 2, fragment)
       for name, fragment in (
         ("no_list", "missing key 'flights'"), ("empty", "no flights"), ("not_object", "not a JSON object"),
-        ("no_speed", "missing key 'speed_mps'"), ("speed_zero", "non-positive speed"), ("speed_word", "not a finite"),
-        ("speed_fast", "outside 0.1-200 m/s"), ("departure_late", "beyond"), ("service_long", "service_end_s"),
-        ("departure_nan", "not a finite"), ("negative_delay", "negative max_delay_s"), ("one_point", "at least two"),
+        ("no_speed", "missing key 'speed_mps'"), ("speed_zero", "speed_mps must be a number in [0.1, 200], got 0"), ("speed_word", "got 'fast'"),
+        ("speed_fast", "in [0.1, 200], got 1000.0"), ("departure_late", "in [-1e+07, 1e+07]"), ("service_long", "service_end_s"),
+        ("departure_nan", "planned_departure_s must be a number"), ("negative_delay", "max_delay_s must be a number in [0,"), ("one_point", "at least two"),
         ("tower", "passes through a building"), ("ground", "on or below the ground"), ("off_grid", "outside the grid"),
         ("tiny_cell", "more than the limit"), ("radius_11", "conflict_radius"), ("radius_true", "conflict_radius"),
         ("duplicate_id", "duplicate flight id"), ("overlap", "overlaps aircraft A"), ("before_start", "before the service"),
@@ -171,10 +171,61 @@ CASES = [
         ("nofly_badcrs", "", "unknown CRS"), ("nofly_elsewhere", "", "lies on the grid"),
         ("nofly_bad", "", "cannot read GeoJSON"), ("roads_elsewhere", "", "lies on the grid"),
         ("shelter_missing", "", "GeoTIFF not found"))],
+    # --- numbers out of range (issue 22, item 6): one boundary check (uamopt/bounds.py, the scenario's key table) ---
+    *[(f"number-flights-{name.replace('_', '-')}", SCHED + f" --flights {{d}}/flights_{name}.json --out {{out}}", 2, fragment)
+      for name, fragment in (
+        ("departure_big", "planned_departure_s must be a number in [-1e+07, 1e+07], got 1000"),
+        ("departure_huge", "an integer of more than 4300 digits"), ("speed_big", "speed_mps must be a number in [0.1, 200]"),
+        ("delay_big", "max_delay_s must be a number in [0, 1e+07]"), ("cell_big", "'cell' must be three positive sizes"),
+        ("waypoint_big", "point 1 holds 1000"), ("id_newline", "flight F1\\nerror: forged"))],
+    *[(f"number-network-{name.replace('_', '-')}", SCHED + f" --network {{d}}/net_{name}.json --out {{out}}", 2, fragment)
+      for name, fragment in (
+        ("cell_big", "'cell' must be three positive sizes"), ("waypoint_big", "point 1 holds 1000"),
+        ("length_big", "length_m must be a number"), ("layer_inf", "layer_k must be an integer"))],
+    ("number-export-departure-big", "export bluesky {d}/sched_departure_big", 2, "planned_departure_s must be a number"),
+    ("number-export-summary-huge", "export geojson {d}/sched_summary_huge", 2, "an integer of more than 4300 digits"),
+    ("number-export-origin-big", "export geojson {d}/sched_origin_big", 2, "the frame's origin must be a number"),
+    *[(f"number-profile-{name.replace('_', '-')}", f"{SCHED.replace('greedy', '{d}/profile_' + name + '.toml')} --out {{out}}",
+       2, fragment) for name, fragment in (
+        ("limit_big", "time_limit_s must be a number in (0, 1e+07]"), ("limit_huge", "an integer of more than 4300 digits"),
+        ("highs_gap_nan", "HiGHS refuses mip_rel_gap = nan"), ("highs_gap_inf", "HiGHS refuses mip_rel_gap = inf"),
+        ("ga_population_inf", "option population must be int, got inf"),
+        ("ga_population_nan", "option population must be int, got nan"),
+        ("ga_population_1e8", "option population must be an integer in [2, 10000]"),
+        ("ga_t0_big", "option t0 must be a number"), ("soa_points_big", "option multi_points must be an integer"),
+        ("greedy_step_big", "option step_s must be a number in [0.001, 1e+07]"),
+        ("timeindexed_step_tiny", "option step_s must be a number in [0.001, 1e+07], got 1e-300"),
+        ("timeindexed_gap_big", "option mip_rel_gap must be a number"),
+        ("cpsat_unit_tiny", "option time_unit_s must be a number in [1e-06, 1e+07], got 1e-300"))],
+    ("number-scenario-seed-big", "risk {d}/seed_big.toml " + T + " --out {out}", 2, "less than or equal to 9223372036854775807"),
+    ("number-scenario-seed-huge", "risk {d}/seed_huge.toml --out {out}", 2, "an integer of more than 4300 digits"),
+    ("number-set-aircraft-1e30", "flights {P} --set schedule.aircraft=" + str(10**30) + " --out {out}", 2,
+     "'schedule.aircraft': Input should be less than or equal to 1000000000"),
+    ("number-set-plan-seed-1e30", "flights {P} --set schedule.plan_seed=" + str(10**30) + " --out {out}", 2, "schedule.plan_seed"),
+    ("number-set-city-seed-big", "risk {P} --set city.seed=" + str(10**400) + " --out {out}", 2, "city.seed"),
+    ("number-set-value-huge", "risk {P} --set city.seed=" + "9" * 5000 + " --out {out}", 2, "an integer of more than 4300 digits"),
+    ("number-set-extent-1e300", "risk {paper} --set grid.extent=[1e300,1e300,360] --set grid.cell=[1e-300,1e-300,1] --out {out}",
+     2, "'grid.extent': Input should be less than or equal to 1000000"),
+    ("number-set-cell-1e-300", "risk {paper} --set grid.extent=[1e5,1e5,360] --set grid.cell=[1e-300,1e-300,1] --out {out}",
+     2, "more than the limit"),
+    ("number-set-memory-1e300", "risk {paper} --set grid.memory_limit_gb=1e300 --out {out}", 2, "grid.memory_limit_gb"),
+    ("number-set-clearance-1e300", "network {P} --set tracks.clearance_m=1e300 --out {out}", 2, "tracks.clearance_m"),
+    ("number-set-c-h-1e300", "network {P} --set aircraft.c_h=1e300 --out {out}", 2, "aircraft.c_h"),
+    ("number-set-window-1e300", "flights {P} --set schedule.first_departure_window_s=1e300 --out {out}", 2,
+     "first_departure_window_s"),
+    ("number-set-time-step-1e-300", "flights {P} --set schedule.time_step_s=1e-300 --out {out}", 2, "schedule.time_step_s"),
+    ("number-flights-seed-1e30", "flights {P} --seed " + str(10**30) + " --out {out}", 2, "--seed"),
+    ("number-dsm-nofly-big", "risk {d}/dsm_nofly_big.toml --out {out}", 2, "cannot read GeoJSON"),
+    ("number-dsm-nofly-nan", "risk {d}/dsm_nofly_nan.toml --out {out}", 2, "not a finite number"),
+    ("number-bench-seed-count", "bench {P} --solver greedy --seeds 1000000000000 --out {out}", 2, "--seeds 1000000000000"),
+    # --- output paths ---
+    ("out-symlink-loop", "risk {P} --out {d}/out_loop", 2, "Too many levels of symbolic links"),
+    ("out-name-newline", "risk {paper} --out '{d}/out_file\nerror: forged'", 2, "output path is a file"),
 ]
 
 #: run as real subprocesses: the terminal sees one line and no traceback
-SUBPROCESS = ["scenario-deep", "flights-seed-negative", "network-nan", "verify-weights-word", "dsm-inf", "plan-same-point"]
+SUBPROCESS = ["scenario-deep", "flights-seed-negative", "network-nan", "verify-weights-word", "dsm-inf", "plan-same-point",
+              "number-flights-departure-big", "out-name-newline"]
 
 
 @pytest.fixture(scope="module")

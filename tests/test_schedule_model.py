@@ -110,7 +110,7 @@ def _write(tmp_path, raw, name="bad.json"):
     ("malformed", "malformed JSON"),
     ("missing", "missing key 'speed_mps'"),
     ("route", "unknown route 'V9-V1'"),
-    ("speed", "non-positive speed"),
+    ("speed", r"speed_mps must be a number in \[0.1, 200\], got 0"),
     ("outside", "outside the grid"),
     ("overlap", "overlaps aircraft A01's flight F001"),
     ("window", "after the service end"),

@@ -13,7 +13,7 @@ import time
 import warnings
 from pathlib import Path
 
-from uamopt.errors import UamoptError
+from uamopt.errors import UamoptError, printable
 
 EXIT_BAD_INPUT = 2
 _STARTED = time.perf_counter()  # the command's own clock (imports included)
@@ -23,18 +23,21 @@ class _Parser(argparse.ArgumentParser):
     """argparse with the project's one-line error and exit code 2."""
 
     def error(self, message: str) -> None:  # type: ignore[override]
-        sys.stderr.write(f"error: {message} (command line): see `{self.prog} --help`\n")
+        sys.stderr.write(f"error: {printable(message)} (command line): see `{self.prog} --help`\n")
         raise SystemExit(EXIT_BAD_INPUT)
 
 
 def _seed(text: str) -> int:
-    """A seed on the command line: a whole number ≥ 0 (numpy's generators refuse negative seeds)."""
+    """A seed on the command line: a whole number in [0, 2⁶³ − 1] (numpy's generators refuse
+    negative seeds; the range of ``schedule.plan_seed``)."""
+    from uamopt.bounds import INT64_MAX, shown
+
     try:
         value = int(text)
     except ValueError:
         value = -1
-    if value < 0:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number ≥ 0")
+    if not 0 <= value <= INT64_MAX:
+        raise argparse.ArgumentTypeError(f"{shown(text)} is not a whole number in [0, 2^63 - 1]")
     return value
 
 
@@ -105,12 +108,6 @@ def cmd_schedule(args) -> int:
     return 0
 
 
-def _printable(text: str) -> str:
-    """``text`` on one line: a control character a crafted folder put in an id or a path (a newline,
-    NUL, ESC) is shown escaped, as Python writes it in a string (``\\n``, ``\\x00``)."""
-    return "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
-
-
 def cmd_view(args) -> int:
     import time
 
@@ -144,16 +141,24 @@ def cmd_verify(args) -> int:
     try:
         problems = verify_dir(args.dir)
     except UamoptError as exc:  # the folder is untrusted: its error line must stay one line
-        sys.stderr.write(f"error: {_printable(exc.line())}\n")
+        sys.stderr.write(f"error: {printable(exc.line())}\n")
         return EXIT_BAD_INPUT
     for line in problems:
-        print(_printable(line))
-    print(f"{len(problems)} violations" if problems else f"feasible and conflict-free: {_printable(str(args.dir))}")
+        print(printable(line))
+    print(f"{len(problems)} violations" if problems else f"feasible and conflict-free: {printable(str(args.dir))}")
     return 1 if problems else 0
+
+
+#: ``bench --seeds N``: at most this many seeds as a count (each is a solve of every instance)
+MAX_SEED_COUNT = 10_000
 
 
 def cmd_bench(args) -> int:
     from uamopt.experiments.benchmark import cmd_bench as bench
+
+    if args.seeds and len(args.seeds) == 1 and args.seeds[0] > MAX_SEED_COUNT:
+        raise UamoptError(f"--seeds {args.seeds[0]} asks for more than {MAX_SEED_COUNT:,} runs per profile", "--seeds",
+                          "give a count up to that (--seeds 3 runs seeds 0, 1, 2) or list the seeds (--seeds 0 7)")
 
     return bench(args)
 
@@ -245,7 +250,7 @@ def _interrupted(args, interrupt: KeyboardInterrupt) -> int:
     if folder:
         line = (f"{describe(interrupt)}: the results in {folder} were complete before the interrupt" if published(folder)
                 else f"{line} to {folder}")
-    sys.stderr.write(line + "\n")
+    sys.stderr.write(printable(line) + "\n")
     return handled(interrupt)
 
 
@@ -262,6 +267,15 @@ def _warning_line(message, category, filename, lineno, file=None, line=None) -> 
 _PYTHON_SHOWWARNING = warnings.showwarning
 
 
+def _out_of_memory(args, exc: MemoryError) -> str:
+    """The one line of a run that ran out of memory; the staging folder is gone, ``--out`` untouched."""
+    detail = " ".join(str(exc).split()) or "an allocation failed"
+    return UamoptError(f"out of memory: {detail}", f"uamopt {args.command}",
+                       "use larger cells (grid.cell), a smaller grid.extent or fewer flights; grid.memory_limit_gb and "
+                       "schedule.memory_limit_gb (default: 80 % of the memory, within ulimit -v) refuse such runs up "
+                       "front; nothing was written").line()
+
+
 def main(argv: list[str] | None = None) -> int:
     from uamopt.interrupts import install_handlers, interrupt_of
 
@@ -275,6 +289,9 @@ def main(argv: list[str] | None = None) -> int:
         return args.func(args)
     except UamoptError as exc:
         sys.stderr.write(f"error: {exc.line()}\n")
+        return EXIT_BAD_INPUT
+    except MemoryError as exc:  # past the memory guards (an address-space limit, ulimit -v): one line, not a traceback
+        sys.stderr.write(f"error: {_out_of_memory(args, exc)}\n")
         return EXIT_BAD_INPUT
     except Exception as exc:
         interrupt = interrupt_of(exc)  # a library that wrapped the KeyboardInterrupt in its own error

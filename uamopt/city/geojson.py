@@ -16,6 +16,7 @@ import numpy as np
 import shapely
 import shapely.geometry
 
+from uamopt.bounds import parse_error
 from uamopt.errors import InputFileError
 
 _KINDS = {"LineString": (1, 5), "Polygon": (3, 6)}  # shapely type ids of a kind and its Multi form
@@ -55,11 +56,16 @@ def _read(path: Path, where: str, kinds: tuple[str, ...]) -> tuple[list[shapely.
             raw = [doc.get("geometry")]
         else:
             raw = [doc]
-        geoms = np.asarray([shapely.geometry.shape(g) for g in raw if g], dtype=object)
+        with np.errstate(invalid="ignore"):  # a NaN coordinate: refused below, in one line, not warned about
+            geoms = np.asarray([shapely.geometry.shape(g) for g in raw if g], dtype=object)
     except (OSError, UnicodeDecodeError, ValueError, KeyError, TypeError, AttributeError, RecursionError,
-            shapely.errors.ShapelyError) as exc:
-        raise InputFileError(f"cannot read GeoJSON {path}: {exc.__class__.__name__}: {exc}", where,
+            OverflowError, shapely.errors.ShapelyError) as exc:  # OverflowError: a 400-digit coordinate
+        text = parse_error(exc) if isinstance(exc, ValueError) else " ".join(str(exc).split())
+        raise InputFileError(f"cannot read GeoJSON {path}: {exc.__class__.__name__}: {text}", where,
                              "give a valid GeoJSON FeatureCollection (RFC 7946)") from None
+    if len(geoms) and not np.isfinite(shapely.get_coordinates(geoms)).all():
+        raise InputFileError(f"GeoJSON {path} holds a coordinate that is not a finite number (NaN or inf)", where,
+                             "give every coordinate as a number")
     parts = shapely.get_parts(geoms) if len(geoms) else geoms
     wanted = [t for kind in kinds for t in _KINDS[kind]]
     kept = parts[np.isin(shapely.get_type_id(parts), wanted) & ~shapely.is_empty(parts)] if len(parts) else parts

@@ -11,6 +11,7 @@ import json
 from dataclasses import dataclass
 from pathlib import Path
 
+from uamopt.bounds import parse_error
 from uamopt.errors import InputFileError
 from uamopt.export.frame import LocalFrame, synthetic_frame
 from uamopt.schedule.flights import Flight, FlightSet, load_flights
@@ -79,8 +80,9 @@ def read_schedule_folder(path: str | Path) -> ScheduleFolder:
     if summary_path.is_file():
         try:
             summary = json.loads(summary_path.read_text(encoding="utf-8-sig"))
-        except (json.JSONDecodeError, UnicodeDecodeError, RecursionError) as exc:
-            raise InputFileError(f"malformed JSON: {exc}", str(summary_path), "rewrite it with uamopt schedule") from None
+        except (ValueError, RecursionError, OSError) as exc:  # JSONDecodeError, UnicodeDecodeError, > 4300 digits
+            raise InputFileError(f"malformed JSON: {parse_error(exc) if isinstance(exc, ValueError) else exc}",
+                                 str(summary_path), "rewrite it with uamopt schedule") from None
         if not isinstance(summary, dict):
             raise InputFileError("summary.json does not hold a JSON object", str(summary_path),
                                  "rewrite it with uamopt schedule")

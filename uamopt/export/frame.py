@@ -91,9 +91,12 @@ class LocalFrame:
     def from_dict(cls, raw: dict, where: str) -> LocalFrame:
         from pyproj.exceptions import CRSError
 
+        from uamopt.bounds import Range, check_number
+
         try:
-            frame = cls(crs=str(raw["crs"]), origin=(float(raw["origin"][0]), float(raw["origin"][1])),
-                        source=str(raw.get("source", "")))
+            origin = tuple(check_number(v, "the frame's origin", where, "rewrite the folder with uamopt schedule",
+                                        Range(-1e8, 1e8)) for v in raw["origin"][:2])  # projected metres
+            frame = cls(crs=str(raw["crs"]), origin=(origin[0], origin[1]), source=str(raw.get("source", "")))
             _transformers(frame.crs)
         except (KeyError, TypeError, ValueError, IndexError, CRSError) as exc:
             raise InputFileError(f"malformed 'frame': {exc.__class__.__name__}: {exc}", where,

@@ -7,6 +7,7 @@ x = (i − ½)Δx with its 1-based i (docs/readings.md). The grid holds a = ⌊x
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -141,26 +142,56 @@ BYTES_PER_CELL = 160
 
 
 def memory_limit_bytes(limit_gb: float | None = None) -> int:
-    """``limit_gb`` (``grid.memory_limit_gb``) in bytes, or 80 % of this machine's physical memory."""
+    """``limit_gb`` (``grid.memory_limit_gb``) in bytes, or 80 % of this machine's physical memory,
+    within the process's address-space limit (``ulimit -v``, less what is mapped already) when one is set."""
     if limit_gb is not None:
         return int(limit_gb * 2**30)
-    try:
-        import os
+    import os
 
-        return int(0.8 * os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
+    try:
+        limit = int(0.8 * os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
     except (ValueError, OSError, AttributeError):  # not a POSIX machine: 8 GB
-        return 8 * 2**30
+        limit = 8 * 2**30
+    return min(limit, _address_space_left())
+
+
+def _address_space_left() -> int:
+    """Bytes the address-space limit (RLIMIT_AS, ``ulimit -v``) leaves beyond what this process has
+    mapped, 80 % of it; unlimited (a huge number) when no limit is set or it cannot be read."""
+    try:
+        import resource
+
+        soft = resource.getrlimit(resource.RLIMIT_AS)[0]
+        if soft == resource.RLIM_INFINITY:
+            return 2**62
+        with open("/proc/self/statm", encoding="ascii") as fh:
+            mapped = int(fh.read().split()[0]) * resource.getpagesize()
+    except (ImportError, OSError, ValueError, IndexError):
+        return 2**62
+    return max(int(0.8 * (soft - mapped)), 0)
+
+
+def gigabytes(n_bytes: float) -> str:
+    """``n_bytes`` in GB (2³⁰ bytes) for an error line, one decimal; three digits and an exponent when huge.
+
+    >>> gigabytes(81_000_000_000), gigabytes(1e305)
+    ('75.4', '9.31e+295')
+    """
+    gb = n_bytes / 2**30
+    return f"{gb:.1f}" if gb < 1e6 else f"{gb:.3g}"
 
 
 def check_memory(cell, extent, limit_bytes: int) -> None:
-    """Refuse a grid whose run would need more than ``limit_bytes``, before anything is allocated."""
-    cells = 1
+    """Refuse a grid whose run would need more than ``limit_bytes``, before anything is allocated.
+    The count is a float, so a tiny cell in a large extent (1e300 cells) is refused, not an overflow."""
+    cells = 1.0
     for e, c in zip(extent, cell):
-        cells *= max(int(e / c + 1e-9), 0)
+        cells *= max(math.floor(e / c + 1e-9), 0) if math.isfinite(e / c) else math.inf
     need = cells * BYTES_PER_CELL
     if need > limit_bytes:
+        count = f"{int(cells):,}" if cells < 1e15 else f"{cells:.3g}"
         raise GridError(
-            f"a grid of {cells:,} cells needs about {need / 2**30:.1f} GB, more than the limit of {limit_bytes / 2**30:.1f} GB",
+            f"a grid of {count} cells needs about {gigabytes(need)} GB, more than the limit of {gigabytes(limit_bytes)} GB",
             "grid.cell / grid.extent", "use larger cells or a smaller extent, or raise grid.memory_limit_gb")
 
 

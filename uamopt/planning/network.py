@@ -121,25 +121,38 @@ class RouteNetwork:
 
         Raises ``ValueError`` naming the route: no routes, waypoints that are not at least two
         finite [x, y, z] points, a track of zero length, a cell that is not three positive sizes."""
+        from uamopt.bounds import Range, check_cell, check_number, check_points
+
+        COST, LAYER = Range(0.0, 1e300), Range(0, 10**6, integer=True)
+
         if not isinstance(doc, dict) or not isinstance(doc.get("routes"), dict) or not doc["routes"]:
             raise ValueError("'routes' must be a non-empty object of route name -> track")
         routes = {}
+        fix = "regenerate it with `uamopt network`"
         for name, r in doc["routes"].items():
-            waypoints = np.asarray(r["waypoints"], dtype=float)
-            if waypoints.ndim != 2 or waypoints.shape[1] != 3 or len(waypoints) < 2 or not np.isfinite(waypoints).all():
-                raise ValueError(f"route {name}: waypoints must be a list of at least two finite [x, y, z]")
-            if not np.linalg.norm(np.diff(waypoints, axis=0), axis=1).sum() > 0:
+            where = f"route {name[:40]}"
+            if not isinstance(r, dict):
+                raise _Invalid(f"{where}: not an object with 'waypoints'")
+            # every number through the one boundary check (uamopt/bounds.py): 400-digit integers, NaN, inf refused
+            waypoints = check_points(r.get("waypoints"), f"{where}: waypoints", where, fix, error=_Invalid)
+            length = float(np.linalg.norm(np.diff(waypoints, axis=0), axis=1).sum())
+            if not length > 0:
                 raise ValueError(f"route {name}: the track has zero length (its flights would take no time)")
+            # the optional costs: NaN when absent (null), else a finite number ≥ 0
+            metric = {key: np.nan if r.get(key) is None else check_number(r[key], f"{where}: {key}", where, fix, COST,
+                                                                          error=_Invalid)
+                      for key in ("length_m", "risk_cost", "transport_cost", "buffer_cost")}
+            layer = r.get("layer_k")
             routes[name] = RouteTrack(
                 name=name, origin=str(r.get("origin", name.split("-")[0])),
                 destination=str(r.get("destination", name.split("-")[-1])), waypoints=waypoints,
-                length_m=float(r.get("length_m", np.linalg.norm(np.diff(waypoints, axis=0), axis=1).sum())),
-                risk_cost=float(r.get("risk_cost", np.nan)), transport_cost=float(r.get("transport_cost", np.nan)),
-                buffer_cost=float(r.get("buffer_cost", np.nan)),
-                layer_k=None if r.get("layer_k") is None else int(r["layer_k"]))
-        cell = tuple(float(c) for c in doc.get("cell", (np.nan, np.nan, np.nan)))
-        if "cell" in doc and not (len(cell) == 3 and all(np.isfinite(c) and c > 0 for c in cell)):
-            raise ValueError(f"'cell' must be three positive sizes in metres, got {doc['cell']!r}")
+                length_m=length if r.get("length_m") is None else metric["length_m"], risk_cost=metric["risk_cost"],
+                transport_cost=metric["transport_cost"], buffer_cost=metric["buffer_cost"],
+                layer_k=None if layer is None else check_number(layer, f"{where}: layer_k", where, fix, LAYER,
+                                                                error=_Invalid))
+        cell = (np.nan, np.nan, np.nan)
+        if "cell" in doc:
+            cell = check_cell(doc["cell"], "network.json", fix, error=_Invalid)
         return cls(routes=routes, cell=cell, scenario=str(doc.get("scenario", "")),  # type: ignore[arg-type]
                    stage=str(doc.get("stage", "optimal")), layering=str(doc.get("layering", "direction")))
 
@@ -213,6 +226,13 @@ def straight_routes(model: PlanningModel, progress=None) -> RouteNetwork:
                         model.scenario.tracks.layering)
 
 
+class _Invalid(ValueError):
+    """A field of network.json out of its range (``from_document`` raises ValueError: the loader names the file)."""
+
+    def __init__(self, what: str, where: str = "", fix: str = "") -> None:
+        super().__init__(what)
+
+
 def load_network(path: str | Path) -> RouteNetwork:
     """A :class:`RouteNetwork` from ``network.json`` (a file, or the folder holding it)."""
     path = Path(path)
@@ -221,9 +241,13 @@ def load_network(path: str | Path) -> RouteNetwork:
     try:
         doc = json.loads(path.read_text(encoding="utf-8-sig"))
         return RouteNetwork.from_document(doc)
+    except ValueError as exc:  # malformed JSON (an integer of more than 4300 digits too) or a field out of range
+        from uamopt.bounds import parse_error
+
+        raise InputFileError(f"malformed network file: {parse_error(exc)}", str(path), "regenerate it with `uamopt network`") from None
     except FileNotFoundError:
         raise InputFileError(f"network file not found: {path}", "network.json", "run `uamopt network` first") from None
-    except (ValueError, KeyError, TypeError, AttributeError, RecursionError) as exc:
+    except (KeyError, TypeError, AttributeError, RecursionError) as exc:
         raise InputFileError(f"malformed network file: {exc}", str(path), "regenerate it with `uamopt network`") from None
     except OSError as exc:
         raise InputFileError(f"cannot read the network file: {exc.strerror or exc}", str(path),

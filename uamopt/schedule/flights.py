@@ -35,8 +35,18 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from uamopt.bounds import (
+    CONFLICT_RADIUS,
+    DURATION_S,
+    SPEED_MPS,
+    TIME_S,
+    VERTICAL_RATE_MPS,
+    check_cell,
+    check_number,
+    check_points,
+    parse_error,
+)
 from uamopt.errors import InputFileError
-from uamopt.schedule.verify import MAX_TIME_S, SPEED_RANGE_MPS  # a file the verifier would refuse is refused first
 
 if TYPE_CHECKING:
     from uamopt.grid import AirspaceGrid
@@ -44,8 +54,8 @@ if TYPE_CHECKING:
 
 DEFAULT_SERVICE_S = 3600.0  # T_f − T_s, s: one hour reproduces F = 6 per aircraft (Eq. 23, Table B.3)
 TIME_TOL_S = 1e-6  # slack for float round-off in time comparisons, s
-MAX_CONFLICT_RADIUS = 10  # r of a flights file: a zone of at most 21³ cells (schedule.conflict_radius's range)
-MAX_VERTICAL_RATE_MPS = 50.0  # climb/descent rate a flights file may claim, m/s (the verifier's range)
+# a flights file's numbers are held to uamopt/bounds.py's ranges, the verifier's own (a file the verifier would
+# refuse is refused first; tests/test_numbers_hostile.py checks that the two agree)
 
 
 def _frozen(array: np.ndarray) -> np.ndarray:
@@ -304,56 +314,42 @@ def flight_from_dict(raw: Any, where: str, network: Mapping[str, np.ndarray] | N
     if not isinstance(raw, dict):
         raise InputFileError("a flight is not a JSON object", where, 'write each flight as {"id": ..., ...}')
     fid = raw.get("id")
-    where = f"{where}: flight {fid}" if fid is not None else where
+    where = f"{where}: flight {str(fid)[:40]}" if fid is not None else where
     required = ["id", "aircraft", "route", "origin", "destination", "speed_mps", "planned_departure_s"]
     missing = [k for k in required if k not in raw]
     if missing:
         raise InputFileError(f"missing key '{missing[0]}'", where, f"every flight needs {', '.join(required)}")
-    for key in ("speed_mps", "planned_departure_s", "max_delay_s"):
-        if key in raw and (isinstance(raw[key], bool) or not isinstance(raw[key], (int, float)) or not math.isfinite(raw[key])):
-            raise InputFileError(f"'{key}' is not a finite number: {raw[key]!r}", where, f"give '{key}' in seconds or m/s")
-    if raw["speed_mps"] <= 0:
-        raise InputFileError(f"non-positive speed {raw['speed_mps']!r}", where, "give 'speed_mps' > 0 (v_g, m/s)")
-    if not SPEED_RANGE_MPS[0] <= raw["speed_mps"] <= SPEED_RANGE_MPS[1]:  # what the verifier accepts, checked
-        raise InputFileError(f"speed_mps {raw['speed_mps']:g} is outside {SPEED_RANGE_MPS[0]:g}-{SPEED_RANGE_MPS[1]:g} m/s",
-                             where, "give v_g in m/s (the paper's eVTOL cruises at 25 m/s)")  # before, not after, writing
-    if "max_delay_s" in raw and raw["max_delay_s"] < 0:
-        raise InputFileError(f"negative max_delay_s {raw['max_delay_s']!r}", where, "give 'max_delay_s' ≥ 0 (Δd, Eq. 29)")
-    for key in ("planned_departure_s", "max_delay_s"):
-        if abs(raw.get(key, 0.0)) > MAX_TIME_S:
-            raise InputFileError(f"'{key}' {raw[key]:g} s is beyond ±{MAX_TIME_S:g} s", where,
-                                 "give times in seconds from the start of service")
+    # every number through the one boundary check (uamopt/bounds.py), before any arithmetic
+    speed = check_number(raw["speed_mps"], "speed_mps", where, "give v_g in m/s (the paper's eVTOL cruises at 25 m/s)",
+                         SPEED_MPS)
+    departure = check_number(raw["planned_departure_s"], "planned_departure_s", where,
+                             "give times in seconds from the start of service", TIME_S)
+    max_delay = raw.get("max_delay_s")
+    if max_delay is not None:
+        max_delay = check_number(max_delay, "max_delay_s", where, "give 'max_delay_s' ≥ 0 (Δd, Eq. 29) in seconds",
+                                 DURATION_S)
     if "waypoints" in raw:
-        try:
-            wp = np.array(raw["waypoints"], dtype=float)
-        except (TypeError, ValueError):
-            wp = np.zeros((0,))
-        if wp.ndim != 2 or wp.shape[1] != 3 or len(wp) < 2 or not np.all(np.isfinite(wp)):
-            raise InputFileError("'waypoints' is not a list of at least two [x, y, z] points", where, "give the track in metres")
-    elif network is not None and raw["route"] in network:
+        wp = check_points(raw["waypoints"], "'waypoints'", where, "give the track in metres")
+    elif network is not None and isinstance(raw["route"], str) and raw["route"] in network:
         wp = np.array(network[raw["route"]], dtype=float)
     else:
         known = ", ".join(sorted(network)) if network else "none (no network given)"
-        raise InputFileError(f"unknown route '{raw['route']}'", where, f"give 'waypoints' or one of the routes: {known}")
+        raise InputFileError(f"unknown route '{str(raw['route'])[:80]}'", where, f"give 'waypoints' or one of the routes: {known}")
     if track_length_m(wp) <= 0:
         raise InputFileError("the track has zero length", where, "give an origin and a destination that differ")
     rate = raw.get("vertical_rate_mps")
     if rate is not None:
-        if isinstance(rate, bool) or not isinstance(rate, (int, float)) or not 0 < rate <= MAX_VERTICAL_RATE_MPS:
-            raise InputFileError(f"'vertical_rate_mps' must be a number in (0, {MAX_VERTICAL_RATE_MPS:g}] m/s, got {rate!r}",
-                                 where, "give the climb/descent rate of the vertical phases, or omit the key")
+        rate = check_number(rate, "'vertical_rate_mps'", where,
+                            "give the climb/descent rate of the vertical phases, or omit the key", VERTICAL_RATE_MPS)
         if len(wp) < 4 or not _vertical(wp[0], wp[1], up=True) or not _vertical(wp[-2], wp[-1], up=False):
             raise InputFileError("'vertical_rate_mps' needs a vertical climb as the first segment and a vertical "
                                  "descent as the last (at least 4 waypoints)", where,
                                  "write the take-off and landing as vertical segments, or omit vertical_rate_mps")
-        rate = float(rate)
     wp.setflags(write=False)
-    max_delay = raw.get("max_delay_s")
     return Flight(
         id=str(raw["id"]), aircraft=str(raw["aircraft"]), route=str(raw["route"]), origin=str(raw["origin"]),
-        destination=str(raw["destination"]), speed_mps=float(raw["speed_mps"]),
-        planned_departure_s=float(raw["planned_departure_s"]),
-        max_delay_s=float("nan") if max_delay is None else float(max_delay), waypoints=wp, vertical_rate_mps=rate,
+        destination=str(raw["destination"]), speed_mps=speed, planned_departure_s=departure,
+        max_delay_s=float("nan") if max_delay is None else max_delay, waypoints=wp, vertical_rate_mps=rate,
     )
 
 
@@ -456,6 +452,9 @@ def load_flights(
         raise InputFileError(f"malformed JSON: {exc.msg} at line {exc.lineno} column {exc.colno}", source, "fix the syntax") from None
     except UnicodeDecodeError:
         raise InputFileError("flights file is not UTF-8 text", source, "save it as UTF-8 JSON") from None
+    except ValueError as exc:  # an integer of more than 4300 digits (Python's int-string limit)
+        raise InputFileError(f"malformed JSON: {parse_error(exc)}", source, "write every number in its range "
+                             "(docs/interfaces.md, flights.json)") from None
     except RecursionError:
         raise InputFileError("the flights file is nested too deeply to read", source, "give a flights.json as "
                              "docs/interfaces.md describes") from None
@@ -476,20 +475,10 @@ def load_flights(
         ("service_start_s", 0.0), ("service_end_s", DEFAULT_SERVICE_S),
         ("outbound_gap_s", sched.outbound_gap_s if sched else 240.0), ("return_gap_s", sched.return_gap_s if sched else 360.0),
     ):
-        value = raw.get(key, default)
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0 <= value <= MAX_TIME_S:
-            raise InputFileError(f"'{key}' must be a number in [0, {MAX_TIME_S:g}] s, got {value!r}", source,
-                                 "give it in seconds")
-        numbers[key] = float(value)
-    try:
-        cell_t = tuple(float(c) for c in cell)
-    except (TypeError, ValueError):
-        cell_t = ()
-    if len(cell_t) != 3 or not all(math.isfinite(c) and c > 0 for c in cell_t):
-        raise InputFileError(f"'cell' must be three positive sizes, got {cell!r}", source, "give [dx, dy, dz] in metres")
-    if isinstance(radius, bool) or not isinstance(radius, int) or not 0 <= radius <= MAX_CONFLICT_RADIUS:
-        raise InputFileError(f"'conflict_radius' must be an integer in [0, {MAX_CONFLICT_RADIUS}], got {radius!r}", source,
-                             "1 = 3×3×3 zone, 0 = same cell (schedule.conflict_radius)")
+        numbers[key] = check_number(raw.get(key, default), f"'{key}'", source, "give it in seconds", DURATION_S)
+    cell_t = check_cell(cell, source)
+    radius = check_number(radius, "'conflict_radius'", source, "1 = 3×3×3 zone, 0 = same cell (schedule.conflict_radius)",
+                          CONFLICT_RADIUS)
     if grid is not None and cell_t != tuple(grid.cell):
         from uamopt.grid.grid import file_grid
 

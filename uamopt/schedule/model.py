@@ -201,7 +201,12 @@ def build_problem(
     distinct aircraft in the flight set (docs/interfaces.md); ΔT_a is ``schedule.time_step_s``.
     """
     from uamopt.schedule.families import scenario_families
+    from uamopt.schedule.occupancy import candidate_count
+    from uamopt.schedule.plan import check_plan_memory
 
+    copies = len(scenario.schedule.speed_options) if scenario is not None else 1  # speed control: a copy per factor
+    check_plan_memory(scenario, len(flightset) * copies, 0, candidate_count(flightset) * copies**2,
+                      "schedule.aircraft / schedule.flights / --flights")
     if weights is None:
         weights = tuple(scenario.schedule.weights) if scenario is not None else (0.6, 0.4)  # type: ignore[assignment]
     if scenario is not None and scenario.schedule.speed_change_cost_s > 0 and tuple(scenario.schedule.speed_options) == (1.0,):

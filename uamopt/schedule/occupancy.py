@@ -299,16 +299,28 @@ def flight_pair_gaps(
     return pair_code, np.append(starts, len(g)).astype(np.int64), lo, hi
 
 
+def _window_counts(flightset: FlightSet) -> tuple[np.ndarray, np.ndarray]:
+    """Flights in order of planned departure, and for each how many later ones depart before its
+    possible flying window [D, D + Δd_upper + flight time] ends (widened by ``TIME_TOL_S``)."""
+    start = flightset.planned_departure_s
+    end = start + flightset.delay_upper_s + flightset.flight_time_s + 2 * TIME_TOL_S
+    order = np.argsort(start, kind="stable")
+    stop = np.searchsorted(start[order], end[order], side="left")
+    return order, np.maximum(stop - np.arange(len(order)) - 1, 0)
+
+
+def candidate_count(flightset: FlightSet) -> int:
+    """The number of flight pairs whose flying windows overlap (those of one aircraft included): an
+    upper bound of :func:`candidate_pairs`'s, counted without making a pair (the memory guard,
+    ``uamopt.schedule.plan.check_plan_memory``)."""
+    return int(_window_counts(flightset)[1].sum())
+
+
 def candidate_pairs(flightset: FlightSet) -> tuple[np.ndarray, np.ndarray]:
     """Flight pairs (p < q, different aircraft) whose possible flying windows
     [D, D + Δd_upper + flight time] overlap (widened by ``TIME_TOL_S``, as in :func:`conflict_table`);
     only those can ever conflict."""
-    start = flightset.planned_departure_s
-    end = start + flightset.delay_upper_s + flightset.flight_time_s + 2 * TIME_TOL_S
-    order = np.argsort(start, kind="stable")
-    s_sorted = start[order]
-    stop = np.searchsorted(s_sorted, end[order], side="left")
-    count = np.maximum(stop - np.arange(len(order)) - 1, 0)
+    order, count = _window_counts(flightset)
     a = np.repeat(np.arange(len(order)), count)
     b = np.repeat(np.cumsum(count) - count, count)
     b = np.arange(count.sum()) - b + a + 1

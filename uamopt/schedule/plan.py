@@ -102,6 +102,37 @@ def grid_vertiports(n: int, extent_m: tuple[float, float], *, margin_m: float = 
         raise UamoptError(str(exc), f"extent {extent_m}", "enlarge the domain or place fewer vertiports") from None
 
 
+#: Peak memory of scheduling a plan, bytes, the guard of ``schedule.memory_limit_gb`` (measured: `uamopt flights`
+#: with straight tracks, 1,200 to 300,000 flights: 530-740 B per flight; 12,000 flights with 12.6 M pairs of
+#: overlapping flying windows: 77 B per pair in the conflict search), with a margin.
+BYTES_PER_FLIGHT = 1000
+BYTES_PER_AIRCRAFT = 200
+BYTES_PER_WINDOW_PAIR = 120
+
+
+def check_plan_memory(scenario: Scenario | None, flights: int, aircraft: int = 0, window_pairs: int = 0,
+                      where: str = "schedule.aircraft / schedule.flights") -> None:
+    """Refuse, before it is made, a plan (``flights`` flights of ``aircraft`` aircraft) or a conflict
+    search (``window_pairs`` pairs of flights whose flying windows overlap,
+    :func:`uamopt.schedule.occupancy.candidate_count`) that would need more memory than
+    ``schedule.memory_limit_gb`` (default ``grid.memory_limit_gb``, else 80 % of this machine's)."""
+    from uamopt.grid.grid import gigabytes, memory_limit_bytes
+
+    limit_gb = None
+    if scenario is not None:
+        limit_gb = scenario.schedule.memory_limit_gb
+        limit_gb = scenario.grid.memory_limit_gb if limit_gb is None else limit_gb
+    limit = memory_limit_bytes(limit_gb)
+    need = flights * BYTES_PER_FLIGHT + aircraft * BYTES_PER_AIRCRAFT + window_pairs * BYTES_PER_WINDOW_PAIR
+    if need > limit:
+        what = f"a plan of {flights:,} flights of {aircraft:,} aircraft" if aircraft else f"scheduling {flights:,} flights"
+        if window_pairs:
+            what += f" with {window_pairs:,} pairs of flights whose flying windows overlap"
+        raise UamoptError(f"{what} needs about {gigabytes(need)} GB, more than the limit of {gigabytes(limit)} GB", where,
+                          "plan fewer flights or aircraft (schedule.flights, schedule.aircraft), or raise "
+                          "schedule.memory_limit_gb")
+
+
 def flights_per_aircraft_list(total: int, n_aircraft: int) -> list[int]:
     """F per aircraft when the plan holds ``total`` flights: ⌊total/G⌋ each, the remainder spread
     one each over the first aircraft.
@@ -196,12 +227,14 @@ def generate_plan(
                 raise UamoptError(f"unknown route '{name}'", "network", f"give tracks for every route; known: {', '.join(network)}")
     if total is None:
         longest = speed * max(waypoint_times_s(t, speed, rate)[-1] for t in network.values())  # L_g/v_g: the longest flight time
-        per_aircraft = [flights_per_aircraft(service_s, longest, speed, sched.outbound_gap_s, sched.return_gap_s,
-                                             sched.interference)] * n_aircraft
-        if per_aircraft[0] < 1:
+        each = flights_per_aircraft(service_s, longest, speed, sched.outbound_gap_s, sched.return_gap_s, sched.interference)
+        if each < 1:
             raise UamoptError(f"the service window of {service_s:g} s holds no round trip (Eq. 23)",
                               "schedule.service_s", "lengthen the service window or set schedule.flights")
+        check_plan_memory(scenario, each * n_aircraft, n_aircraft)  # before a flight is made (G = 10⁷: 60 GB)
+        per_aircraft = [each] * n_aircraft
     else:
+        check_plan_memory(scenario, total, n_aircraft)
         per_aircraft = flights_per_aircraft_list(total, n_aircraft)
     service_end = service_start_s + service_s
     rng = np.random.default_rng(seed)

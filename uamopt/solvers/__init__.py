@@ -95,6 +95,11 @@ def load_profile(name_or_path: str | Path) -> SolverProfile:
     except (OSError, RecursionError) as exc:
         raise ScenarioError(f"cannot read the profile: {getattr(exc, 'strerror', None) or exc}", str(path),
                             "give a readable TOML file") from None
+    except ValueError as exc:  # an integer of more than 4300 digits (Python's int-string limit)
+        from uamopt.bounds import parse_error
+
+        raise ScenarioError(f"the profile holds {parse_error(exc)}", str(path),
+                            "every number of a profile has a range (uamopt/solvers/options.py)") from None
     unknown = set(raw) - _KEYS
     if unknown:
         raise ScenarioError(f"unknown key '{sorted(unknown)[0]}'", str(path), f"valid keys are {', '.join(sorted(_KEYS))}")

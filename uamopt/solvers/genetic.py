@@ -51,6 +51,7 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
+from uamopt.bounds import MAX_TIME_S, Range, check_number, shown
 from uamopt.errors import UamoptError
 from uamopt.schedule.model import Schedule, SchedulingProblem, make_schedule
 from uamopt.solvers.greedy import (  # noqa: F401  (SHAPES, OBJECTIVES: the decoder's, uamopt.solvers.check_supported)
@@ -86,26 +87,35 @@ class GeneticOptions:
 
     @classmethod
     def from_options(cls, options: dict, solver: str) -> GeneticOptions:
-        """Validated options (one-line errors naming the option and its range)."""
+        """Validated options (one-line errors naming the option and its range, :data:`GENETIC_RANGES`)."""
         names = {f.name: f.type for f in fields(cls)}
         refuse_unknown(options, set(names), solver)
         kw = {}
         for key, value in options.items():
             kind = {"int": int, "float": float, "bool": bool}[str(names[key])]
-            if isinstance(value, bool) != (kind is bool) or not isinstance(value, (int, float)) or (kind is int and value != int(value)):
-                raise UamoptError(f"option {key} must be {kind.__name__}, got {value!r}", f"solver {solver}", "fix the profile")
-            kw[key] = kind(value)
-        opts = cls(**kw)
-        checks = [("population", opts.population >= 2, "≥ 2"), ("generations", opts.generations >= 0, "≥ 0"),
-                  ("multi_points", opts.multi_points >= 1, "≥ 1"), ("step_s", opts.step_s > 0, "> 0"),
-                  ("t0", opts.t0 > 0, "> 0"), ("xi", 0 < opts.xi <= 1, "in (0, 1]"), ("t_final", opts.t_final >= 0, "≥ 0"),
-                  ("fitness_scale", opts.fitness_scale > 0, "> 0")]
-        checks += [(k, 0 <= getattr(opts, k) <= 1, "in [0, 1]")
-                   for k in ("crossover_rate", "mutation_rate", "init_rate", "cancel_prob", "elite_fraction")]
-        for key, ok, accepted in checks:
-            if not ok:
-                raise UamoptError(f"option {key} = {getattr(opts, key)} out of range", f"solver {solver}", f"use a value {accepted}")
-        return opts
+            if kind is bool:
+                if not isinstance(value, bool):
+                    raise UamoptError(f"option {key} must be bool, got {shown(value)}", f"solver {solver}", "fix the profile")
+                kw[key] = value
+                continue
+            if kind is int and isinstance(value, float) and value.is_integer():
+                value = int(value)  # 50.0 is 50 (TOML writes what a table generator gave)
+            if isinstance(value, bool) or (kind is int and not isinstance(value, int)):
+                raise UamoptError(f"option {key} must be {kind.__name__}, got {shown(value)}", f"solver {solver}", "fix the profile")
+            valid = GENETIC_RANGES[key]
+            kw[key] = check_number(value, f"option {key}", f"solver {solver}", f"use {valid.text()}", valid, error=UamoptError)
+        return cls(**kw)
+
+
+#: the range of each numeric GA/SOA option: what it can mean (a population of at most 10⁴ individuals,
+#: the paper's is 50; a delay grid of a millisecond to 10⁷ s)
+GENETIC_RANGES = {
+    "population": Range(2, 10_000, integer=True), "generations": Range(0, 10**7, integer=True),
+    "multi_points": Range(1, 10**6, integer=True), "step_s": Range(1e-3, MAX_TIME_S),
+    "t0": Range(0.0, 1e12, lo_open=True), "xi": Range(0.0, 1.0, lo_open=True), "t_final": Range(0.0, 1e12),
+    "fitness_scale": Range(0.0, 1e12, lo_open=True),
+    **{k: Range(0.0, 1.0) for k in ("crossover_rate", "mutation_rate", "init_rate", "cancel_prob", "elite_fraction")},
+}
 
 
 def objective_values(problem: SchedulingProblem, operated: np.ndarray, delay_s: np.ndarray) -> np.ndarray:

@@ -12,12 +12,19 @@ Profile-level fields (``solvers/*.toml``), strict types (a bool is not a number,
 key             type / range                   meaning
 =============== ============================== ==============================================
 solver          one of :data:`SOLVERS`         which solver
-time_limit_s    finite float > 0               wall-clock limit of the whole solve, model
-                                               building included, s
+time_limit_s    float in (0, 10⁷]              wall-clock limit of the whole solve, model
+                                               building included, s (10⁷ s: about 116 days)
 seed            int in [0, 2³¹ − 1]            random seed (HiGHS and CP-SAT take 32-bit seeds)
 threads         int in [1, max(64, 4·cores)]   threads for HiGHS / CP-SAT
 options         table                          per solver, below
 =============== ============================== ==============================================
+
+Every number goes through the one boundary check (uamopt/bounds.py): a 400-digit integer, NaN or
+inf is refused in one line, never an ``OverflowError``. Each solver's own options declare a finite
+range (:data:`OWN`; ``ga``/``soa``: ``GeneticOptions.RANGES``): a delay-grid step or lattice unit
+of at least a millisecond (a microsecond for CP-SAT's unit) and at most 10⁷ s, a GA population of
+at most 10⁴. Options passed to HiGHS are refused when NaN, or infinite unless HiGHS's own default
+for the option is (``objective_bound``); HiGHS and CP-SAT then check their own ranges.
 """
 
 from __future__ import annotations
@@ -27,55 +34,53 @@ import os
 from dataclasses import dataclass
 from typing import Any
 
+from uamopt.bounds import MAX_TIME_S, Range, check_number, shown
 from uamopt.errors import UamoptError
 
 SEED_MAX = 2**31 - 1
 THREADS_MAX = max(64, 4 * (os.cpu_count() or 1))
+TIME_LIMIT_S = Range(0.0, MAX_TIME_S, lo_open=True)
 
 
 @dataclass(frozen=True)
 class Opt:
-    """One option: its type (float, int, bool, str), default, and an accepted range or choices."""
+    """One option: its type (float, int, bool, str), default, and its range (numbers) or choices."""
 
     kind: type
     default: Any = None
-    positive: bool = False  # numbers: > 0
-    at_least: float | None = None  # numbers: ≥ this
+    valid: Range | None = None  # numbers: the values it can take (finite ends)
     choices: tuple = ()
 
     def check(self, key: str, value: Any, where: str) -> Any:
         bad = UamoptError
         if self.kind is bool:
             if not isinstance(value, bool):
-                raise bad(f"option {key} must be true or false, got {value!r}", where, f"write {key} = true or false")
+                raise bad(f"option {key} must be true or false, got {shown(value)}", where, f"write {key} = true or false")
             return value
         if self.kind is str:
             if not isinstance(value, str) or (self.choices and value not in self.choices):
-                raise bad(f"option {key} = {value!r} is not one of {', '.join(map(repr, self.choices))}", where,
+                raise bad(f"option {key} = {shown(value)} is not one of {', '.join(map(repr, self.choices))}", where,
                           f"use one of {', '.join(self.choices)}")
             return value
-        number = isinstance(value, (int, float)) and not isinstance(value, bool)
-        if not number or (self.kind is int and (not isinstance(value, int))) or not math.isfinite(value):
-            raise bad(f"option {key} must be a finite {'integer' if self.kind is int else 'number'}, got {value!r}",
-                      where, "fix the profile")
-        if (self.positive and not value > 0) or (self.at_least is not None and value < self.at_least):
-            accepted = "> 0" if self.positive else f"≥ {self.at_least:g}"
-            raise bad(f"option {key} = {value!r} out of range", where, f"use a value {accepted}")
-        return self.kind(value)
+        assert self.valid is not None, f"option {key} declares no range"  # every numeric option declares one
+        return check_number(value, f"option {key}", where, f"use {self.valid.text()}", self.valid, error=bad)
 
 
-POSITIVE_S = Opt(float, positive=True)
+STEP_S = Range(1e-3, MAX_TIME_S)  # a delay grid's step, s: a millisecond to 10⁷ s
+POSITIVE_S = Opt(float, valid=STEP_S)
+SECONDS = Range(0.0, MAX_TIME_S)
 #: each solver's own options (``ga``/``soa`` are declared by ``GeneticOptions`` in genetic.py)
 OWN: dict[str, dict[str, Opt]] = {
     "greedy": {"step_s": POSITIVE_S, "exact_gaps": Opt(bool, False)},
     "highs": {},
-    "cpsat": {"time_unit_s": Opt(float, 0.01, positive=True), "continuous_bound": Opt(bool, True)},
-    "rolling": {"window_s": Opt(float, 900.0, positive=True), "inner": Opt(str, "cpsat", choices=("cpsat", "highs")),
-                "window_time_limit_s": POSITIVE_S, "time_unit_s": Opt(float, 0.01, positive=True), "step_s": POSITIVE_S},
-    "timeindexed": {"step_s": Opt(float, 10.0, positive=True), "model": Opt(str, "grid", choices=("grid", "relaxed")),
+    "cpsat": {"time_unit_s": Opt(float, 0.01, valid=Range(1e-6, MAX_TIME_S)), "continuous_bound": Opt(bool, True)},
+    "rolling": {"window_s": Opt(float, 900.0, valid=Range(1.0, MAX_TIME_S)), "inner": Opt(str, "cpsat", choices=("cpsat", "highs")),
+                "window_time_limit_s": Opt(float, valid=TIME_LIMIT_S), "time_unit_s": Opt(float, 0.01, valid=Range(1e-6, MAX_TIME_S)),
+                "step_s": POSITIVE_S},
+    "timeindexed": {"step_s": Opt(float, 10.0, valid=STEP_S), "model": Opt(str, "grid", choices=("grid", "relaxed")),
                     "engine": Opt(str, "auto", choices=("auto", "highs", "cpsat", "hybrid")),
-                    "warm_soa_s": Opt(float, 0.0, at_least=0.0), "continuous_bound_s": Opt(float, 0.0, at_least=0.0),
-                    "continuous_bound_step_s": POSITIVE_S, "mip_rel_gap": Opt(float, 0.0, at_least=0.0)},
+                    "warm_soa_s": Opt(float, 0.0, valid=SECONDS), "continuous_bound_s": Opt(float, 0.0, valid=SECONDS),
+                    "continuous_bound_step_s": POSITIVE_S, "mip_rel_gap": Opt(float, 0.0, valid=Range(0.0, 1e6))},
 }
 #: solvers that hand every other option to the underlying library, after checking it there
 PASS_THROUGH = {"highs": "HiGHS", "cpsat": "CP-SAT"}
@@ -83,8 +88,6 @@ PASS_THROUGH = {"highs": "HiGHS", "cpsat": "CP-SAT"}
 RESERVED = {"highs": {"time_limit": "time_limit_s", "threads": "threads", "random_seed": "seed"},
             "cpsat": {"max_time_in_seconds": "time_limit_s", "num_workers": "threads", "num_search_workers": "threads",
                       "random_seed": "seed", "catch_sigint_signal": "Ctrl-C handling (uamopt.interrupts)"}}
-
-
 def refuse_unknown(options: dict, known: set[str], solver: str) -> None:
     """Raise on an option the solver does not know (validate at the boundary)."""
     unknown = sorted(set(options) - known)
@@ -96,16 +99,11 @@ def refuse_unknown(options: dict, known: set[str], solver: str) -> None:
 def check_profile_fields(name: str, time_limit_s: Any, seed: Any, threads: Any) -> None:
     """Strict types and ranges of a profile's own fields (module docstring)."""
     where = f"profile {name}"
-    if isinstance(time_limit_s, bool) or not isinstance(time_limit_s, (int, float)) or not (
-            math.isfinite(time_limit_s) and time_limit_s > 0):
-        raise UamoptError(f"time_limit_s must be a positive number of seconds, got {time_limit_s!r}", where,
-                          "give a time limit in seconds, e.g. 60")
-    if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed <= SEED_MAX:
-        raise UamoptError(f"seed must be an integer in [0, {SEED_MAX}], got {seed!r}", where,
-                          "HiGHS and CP-SAT take 32-bit seeds; use e.g. 0")
-    if isinstance(threads, bool) or not isinstance(threads, int) or not 1 <= threads <= THREADS_MAX:
-        raise UamoptError(f"threads must be an integer in [1, {THREADS_MAX}], got {threads!r}", where,
-                          f"use 1 to {THREADS_MAX} (this machine has {os.cpu_count()} cores)")
+    check_number(time_limit_s, "time_limit_s", where, "give a time limit in seconds, e.g. 60", TIME_LIMIT_S, error=UamoptError)
+    check_number(seed, "seed", where, "HiGHS and CP-SAT take 32-bit seeds; use e.g. 0", Range(0, SEED_MAX, integer=True),
+                 error=UamoptError)
+    check_number(threads, "threads", where, f"use 1 to {THREADS_MAX} (this machine has {os.cpu_count()} cores)",
+                 Range(1, THREADS_MAX, integer=True), error=UamoptError)
 
 
 def check_options(solver: str, options: Any, name: str) -> None:
@@ -141,14 +139,22 @@ def _check_highs(options: dict, where: str) -> None:
 
     h = quiet_highs()
     for key, value in options.items():
+        known = h.getOptionType(key)[0] == highspy.HighsStatus.kOk
         if isinstance(value, bool) and h.getOptionType(key)[1] != highspy.HighsOptionType.kBool:
             ok = False  # HiGHS would read true as 1
+        elif isinstance(value, float) and not math.isfinite(value):
+            # HiGHS takes NaN for any double and inf for a gap: refused, but where HiGHS's own default is
+            # infinite (objective_bound = inf: no bound), inf means that default
+            default = h.getOptionValue(key)[1] if known else None
+            ok = not math.isnan(value) and isinstance(default, float) and math.isinf(default) \
+                and h.setOptionValue(key, value) == highspy.HighsStatus.kOk
+        elif isinstance(value, int) and not isinstance(value, bool) and not -2**63 <= value < 2**63:
+            ok = False  # beyond int64: no HiGHS option is that wide
         else:
             ok = h.setOptionValue(key, value) == highspy.HighsStatus.kOk
         if not ok:
-            known = h.getOptionType(key)[0] == highspy.HighsStatus.kOk
             raise UamoptError(f"HiGHS {'refuses' if known else 'has no option'} {key}"
-                              + (f" = {value!r}" if known else ""), where,
+                              + (f" = {shown(value)}" if known else ""), where,
                               "see https://ergo-code.github.io/HiGHS/stable/options/definitions/")
 
 
@@ -172,7 +178,7 @@ def _check_cpsat(options: dict, where: str) -> None:
                 setattr(params, key, value)
         except (AttributeError, TypeError, ValueError) as exc:
             reason = " ".join(str(exc).split()[:12])  # pybind's message lists every signature: keep its start
-            raise UamoptError(f"CP-SAT refuses {key} = {value!r} ({reason})", where,
+            raise UamoptError(f"CP-SAT refuses {key} = {shown(value)} ({reason})", where,
                               "see ortools/sat/sat_parameters.proto") from None
     model = cp_model.CpModel()
     model.add_bool_or([model.new_bool_var("x")])
