@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from uamopt.checks import expect_path
 from uamopt.errors import InputFileError
 
 if TYPE_CHECKING:
@@ -82,6 +83,8 @@ def _json(path: Path) -> dict:
 
 def load_risk(path: str | Path) -> RiskField:
     """The :class:`~uamopt.risk.RiskField` of a risk folder (``risk.npz`` and ``summary.json``)."""
+    expect_path(path, "path", "load_risk")
+
     from uamopt.city.layers import CityLayers
     from uamopt.grid import AirspaceGrid
     from uamopt.risk import RiskConstants, RiskField
@@ -112,6 +115,8 @@ def load_risk(path: str | Path) -> RiskField:
 
 def load_tracks(path: str | Path) -> TrackPlan:
     """The :class:`~uamopt.planning.tracks.TrackPlan` of a plan folder (``tracks.json``)."""
+    expect_path(path, "path", "load_tracks")
+
     from uamopt.planning.tracks import TrackPlan
 
     file = _file(path, "tracks.json")
@@ -123,6 +128,8 @@ def load_tracks(path: str | Path) -> TrackPlan:
 
 def load_network(path: str | Path) -> RouteNetwork:
     """The :class:`~uamopt.planning.network.RouteNetwork` of a network folder (``network.json``)."""
+    expect_path(path, "path", "load_network")
+
     from uamopt.planning.network import load_network as load
 
     return load(path)  # a folder or the file; "network file not found" names what is missing
@@ -130,6 +137,8 @@ def load_network(path: str | Path) -> RouteNetwork:
 
 def load_flights(path: str | Path, scenario=None, grid=None, network=None) -> FlightSet:
     """The :class:`~uamopt.schedule.flights.FlightSet` of ``flights.json`` (validated)."""
+    expect_path(path, "path", "load_flights")
+
     from uamopt.schedule.flights import load_flights as load
 
     return load(_file(path, "flights.json"), scenario, grid, network)
@@ -138,6 +147,8 @@ def load_flights(path: str | Path, scenario=None, grid=None, network=None) -> Fl
 def load_schedule(path: str | Path) -> Schedule:
     """The :class:`~uamopt.schedule.model.Schedule` of a schedule folder (``schedule.csv`` and
     ``summary.json``), rows in schedule.csv order."""
+    expect_path(path, "path", "load_schedule")
+
     from uamopt.schedule.model import Schedule
 
     file = _file(path, "schedule.csv")

@@ -26,14 +26,16 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from uamopt.checks import expect
+from uamopt.errors import UamoptError
 from uamopt.scenario import Scenario
 
 if TYPE_CHECKING:
     import pandas as pd
 
+    from uamopt.grid import AirspaceGrid
     from uamopt.planning.network import RouteNetwork
     from uamopt.planning.problem import PlanningModel
-    from uamopt.grid import AirspaceGrid
     from uamopt.risk import RiskField
     from uamopt.schedule.flights import FlightSet
     from uamopt.schedule.model import Schedule, SchedulingProblem
@@ -46,6 +48,7 @@ def scenario_grid(scenario: Scenario) -> AirspaceGrid:
     from uamopt.city import source_extent
     from uamopt.grid import build_grid
 
+    expect(scenario, Scenario, "scenario", "scenario_grid")
     if scenario.grid.extent is not None:
         extent = scenario.grid.extent
     else:
@@ -63,6 +66,7 @@ def compute_risk(scenario: Scenario) -> RiskField:
     from uamopt.city import load_city
     from uamopt.risk import risk_field
 
+    expect(scenario, Scenario, "scenario", "compute_risk")
     t0 = time.perf_counter()
     grid = scenario_grid(scenario)
     city = load_city(scenario, grid)
@@ -76,7 +80,15 @@ def compute_risk(scenario: Scenario) -> RiskField:
 def planning_model(scenario: Scenario, field: RiskField) -> PlanningModel:
     """Admissible cells, Eq. 11 risk, the safety buffer R(t) of Eq. 35 and transport rates."""
     from uamopt.planning.problem import planning_model as build
+    from uamopt.risk import RiskField
 
+    expect(scenario, Scenario, "scenario", "planning_model")
+    expect(field, RiskField, "field", "planning_model")
+    made_for = field.meta.get("scenario")
+    if (made_for is not None and made_for != scenario.name) or tuple(field.grid.cell) != tuple(map(float, scenario.grid.cell)):
+        raise UamoptError(f"the risk field was computed for another scenario ({made_for!r}, cells {field.grid.cell}), "
+                          f"not {scenario.name!r} (cells {tuple(scenario.grid.cell)})", "planning_model(scenario, field)",
+                          "pass the field ua.compute_risk(scenario) returned for this scenario")
     return build(scenario, field)
 
 
@@ -84,8 +96,10 @@ def plan_track(model: PlanningModel, origin=None, destination=None, **options):
     """The four stages of Fig. 18 / Table 2 between two points (x, y, z m) or vertiport names;
     omitted: the scenario's route (``tracks.route``, else the first and farthest vertiports)."""
     from uamopt.planning.endpoints import default_endpoints
+    from uamopt.planning.problem import PlanningModel
     from uamopt.planning.tracks import plan_track as plan
 
+    expect(model, PlanningModel, "model", "plan_track")
     if origin is None or destination is None:
         o, d = default_endpoints(model.scenario)
         origin = o if origin is None else origin
@@ -96,7 +110,9 @@ def plan_track(model: PlanningModel, origin=None, destination=None, **options):
 def plan_network(model: PlanningModel, progress=None) -> RouteNetwork:
     """One planned track per route and direction, directions on separate layers (Sec. 4.1.2, 6.2)."""
     from uamopt.planning.network import plan_network as plan
+    from uamopt.planning.problem import PlanningModel
 
+    expect(model, PlanningModel, "model", "plan_network")
     return plan(model, progress=progress)
 
 
@@ -105,15 +121,29 @@ def generate_flights(scenario: Scenario, network, seed: int | None = None) -> Fl
     name → waypoints); ``seed`` defaults to ``schedule.plan_seed``."""
     from uamopt.schedule.plan import generate_plan
 
-    return generate_plan(scenario, network, scenario.schedule.plan_seed if seed is None else int(seed))
+    expect(scenario, Scenario, "scenario", "generate_flights")
+    return generate_plan(scenario, network, scenario.schedule.plan_seed if seed is None else seed)
 
 
 def build_problem(flights: FlightSet, scenario: Scenario | None = None, *, objective: str | None = None,
                   weights: tuple[float, float] | None = None) -> SchedulingProblem:
     """The scheduling model as data (pair conflicts computed); ``objective`` defaults to
     ``schedule.objective`` (weighted Eq. 20, or lexicographic)."""
+    import math
+
+    from uamopt.schedule.flights import FlightSet
     from uamopt.schedule.model import build_problem as build
 
+    expect(flights, FlightSet, "flights", "build_problem")
+    if scenario is not None:
+        expect(scenario, Scenario, "scenario", "build_problem")
+    if weights is not None:
+        if not (isinstance(weights, (list, tuple)) and len(weights) == 2
+                and all(isinstance(w, (int, float)) and not isinstance(w, bool) for w in weights)):
+            raise TypeError(f"build_problem(): weights must be a pair of numbers (ω6, ω7), got {weights!r}")
+        if not all(math.isfinite(w) and w >= 0 for w in weights):
+            raise UamoptError(f"the objective weights must be finite numbers ≥ 0, got {tuple(weights)}",
+                              "build_problem(weights=...)", "give e.g. (0.6, 0.4), as schedule.weights")
     kind = objective or (scenario.schedule.objective if scenario is not None else "weighted")
     return build(flights, scenario, weights=weights, objective=kind)  # type: ignore[arg-type]
 
@@ -132,8 +162,10 @@ def solver_profile(profile: SolverProfile | str | Path, **overrides) -> SolverPr
 def solve(problem: SchedulingProblem, profile: SolverProfile | str | Path = "greedy", *, extra=None, **overrides) -> Schedule:
     """Run one solver profile on the problem, e.g. ``solve(problem, "highs", time_limit_s=30)``;
     ``extra``: a callback that edits the exact model before it is solved (highs, cpsat; docs/variants.md)."""
+    from uamopt.schedule.model import SchedulingProblem
     from uamopt.solvers import solve as run
 
+    expect(problem, SchedulingProblem, "problem", "solve")
     return run(problem, solver_profile(profile, **overrides), extra=extra)
 
 
@@ -158,9 +190,15 @@ class Verification:
 def verify(problem: SchedulingProblem, schedule: Schedule) -> Verification:
     """Write the schedule as its files and check them with the independent verifier, which shares
     no code with the model (``uamopt.schedule.verify``)."""
-    from uamopt.schedule.model import write_schedule
+    from uamopt.schedule.model import Schedule, SchedulingProblem, write_schedule
     from uamopt.schedule.verify import verify_dir
 
+    expect(problem, SchedulingProblem, "problem", "verify")
+    expect(schedule, Schedule, "schedule", "verify")
+    if len(schedule.operated) != problem.n_flights or (schedule.flight_ids and tuple(schedule.flight_ids) != problem.flights.ids):
+        raise UamoptError(f"the schedule is of another problem ({len(schedule.operated)} flights, the problem has "
+                          f"{problem.n_flights})", "verify(problem, schedule)",
+                          "pass the schedule ua.solve(problem, ...) returned for this problem")
     with tempfile.TemporaryDirectory(prefix="uamopt-verify-") as tmp:
         folder = Path(tmp) / "schedule"
         write_schedule(folder, problem, schedule)

@@ -20,6 +20,7 @@ from pydantic import (BaseModel, BeforeValidator, ConfigDict, Field, PrivateAttr
                       model_validator)
 
 from uamopt.bounds import INT64_MAX, MAX_COORD_M, MAX_TIME_S, Range, digits, parse_error
+from uamopt.checks import expect_path
 from uamopt.errors import ScenarioError
 
 
@@ -610,6 +611,8 @@ def load_scenario(path: str | Path, overrides: list[str] | None = None) -> Scena
     ScenarioError
         Missing or malformed file, unknown key, value out of range.
     """
+    expect_path(path, "path", "load_scenario")
+
     path = Path(path)
     if not path.is_file():
         raise ScenarioError(f"scenario file not found: {path}", str(path), "give the path of a .toml scenario, e.g. models/paper_case.toml")

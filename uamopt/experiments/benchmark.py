@@ -61,8 +61,8 @@ def _instances(problem_or_scenarios) -> dict:
         if isinstance(item, Scenario):
             name, item = name or instance_name(item), scenario_problem(item)
         if not isinstance(item, SchedulingProblem):
-            raise UamoptError(f"cannot benchmark a {type(item).__name__}", "benchmark",
-                              "give SchedulingProblems, Scenarios or scenario files")
+            raise TypeError("benchmark(): problem_or_scenarios must be a SchedulingProblem, Scenario or path "
+                            f"(or a list or dict of them), got {type(item).__name__}")
         name = name or f"instance{i + 1}"
         if name in out:
             name = f"{name}#{i + 1}"
@@ -75,6 +75,9 @@ def _profiles(solvers, time_limit_s):
 
     profiles = [s if isinstance(s, SolverProfile) else load_profile(s)
                 for s in ([solvers] if isinstance(solvers, (str, Path)) else solvers)]
+    if not profiles:
+        raise UamoptError("no solver profile given", "benchmark(solvers=...) / --solver",
+                          "give at least one profile, e.g. ['greedy', 'highs']")
     if time_limit_s is not None:
         if not (isinstance(time_limit_s, (int, float)) and math.isfinite(time_limit_s) and time_limit_s > 0):
             raise UamoptError(f"the time limit must be a positive number of seconds, got {time_limit_s!r}", "--time-limit",

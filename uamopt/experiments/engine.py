@@ -25,6 +25,7 @@ import tempfile
 import threading
 from pathlib import Path
 
+from uamopt.checks import expect_path
 from uamopt.errors import UamoptError
 from uamopt.experiments.case import error_line, run_case
 from uamopt.experiments.progress import Progress
@@ -195,6 +196,8 @@ def sweep(path, out=None, scheduler: str | None = None, workers: int | None = No
         A part of the results folder broke the schema (uamopt/experiments/store.py) and was
         renamed ``NAME.parquet.set-aside``; its case is recomputed.
     """
+    expect_path(path, "path", "sweep")
+
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
         raise UamoptError(f"--workers must be a whole number ≥ 1, got {workers!r}", "--workers", "give a number of worker processes")
     if workers is not None and scheduler:

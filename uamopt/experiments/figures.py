@@ -353,8 +353,12 @@ def plot_sweep(table, kind: str | None = None, ax=None, *, x: str | None = None,
         An unknown ``kind``, a study's key missing from the table, a column or metric the
         table lacks, or more than 12 panels.
     """
+    import pandas as pd
+
+    from uamopt.checks import expect
     from uamopt.errors import UamoptError
 
+    expect(table, pd.DataFrame, "table", "plot_sweep")
     if kind is None:
         return sweep_lines(table, x=x, hue=hue, y=y, ax=ax)
     if kind not in KEYS:

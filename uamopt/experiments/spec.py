@@ -38,6 +38,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
+from uamopt.checks import expect_path
 from uamopt.errors import ScenarioError, UamoptError
 
 STAGES = ("risk", "plan", "network", "schedule")
@@ -309,6 +310,8 @@ def load_sweep(path: str | Path, small: bool = False) -> SweepSpec:
         Unknown key (in the file or a scenario key in ``[set]``/``[grid]``), empty grid, bad
         stage, seeds or solvers, a case whose scenario is invalid.
     """
+    expect_path(path, "path", "load_sweep")
+
     path = Path(path)
     where = str(path)
     raw = _read(path)

@@ -108,7 +108,7 @@ def recorded_scenario(folder: ScheduleFolder, scenario_path: str | None = None, 
     if scenario_path is not None:
         return load_scenario(scenario_path, overrides or [])
     record = folder.scenario or {}
-    if not record.get("file"):
+    if not record.get("file") or not isinstance(record["file"], str):
         raise InputFileError("the folder records no scenario file", str(folder.path / "summary.json"),
                              "pass --scenario FILE (and its --set overrides), or --risk risk.npz")
     return load_scenario(record["file"], list(record.get("set", [])) + list(overrides or []))

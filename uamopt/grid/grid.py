@@ -224,5 +224,11 @@ def build_grid(extent, cell, *, memory_limit_gb: float | None = None) -> Airspac
     >>> build_grid((2500, 4500, 360), (50, 50, 30)).shape
     (50, 90, 12)
     """
+    from uamopt.bounds import MAX_COORD_M, Range, check_cell, shown
+
+    cell = check_cell(cell, "build_grid(cell=...)", "give three cell sizes in metres, each > 0, e.g. (50, 50, 30)", GridError)
+    if not (isinstance(extent, (list, tuple)) and len(extent) == 3 and all(Range(0.0, MAX_COORD_M).holds(e) for e in extent)):
+        raise GridError(f"the extent must be three sizes (x_max, y_max, z_max) in [0, {MAX_COORD_M:g}] m, got {shown(extent)}",
+                        "build_grid(extent=...)", "give e.g. (2500, 4500, 360)")
     check_memory(cell, extent, memory_limit_bytes(memory_limit_gb))
     return AirspaceGrid.from_extent(cell, extent)

@@ -29,6 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
+from uamopt.checks import expect_path
 from uamopt.errors import InputFileError
 
 #: a flight's track: 25 m at 25 m/s, so a landing "flight" lasts 1 s (its arrival plays no part);
@@ -80,6 +81,8 @@ def read_airland(path: str | Path):
     >>> ua.solve(problem, "highs").objective  # doctest: +SKIP
     700.0
     """
+    expect_path(path, "path", "read_airland")
+
     from uamopt.schedule.core import Objective
     from uamopt.schedule.families.pairs import PairIntervals
     from uamopt.schedule.flights import Flight, FlightSet

@@ -219,6 +219,14 @@ def generate_plan(
     speed = scenario.aircraft.cruise_speed_mps
     routes = scenario_routes(scenario)
     rate = scenario.aircraft.vertical_rate_mps if scenario.network.vertical_phases else None
+    for name, wp in network.items():
+        points = np.asarray(wp, dtype=float)
+        if points.ndim != 2 or points.shape[1] != 3 or len(points) < 2 or not np.isfinite(points).all():
+            raise UamoptError(f"route '{name}' must be at least two finite [x, y, z] waypoints, got shape {points.shape}",
+                              "network", "give each route's track as an (n, 3) array of waypoints, n ≥ 2")
+        if not np.linalg.norm(np.diff(points, axis=0), axis=1).sum() > 0:
+            raise UamoptError(f"route '{name}' has zero length (all its waypoints are one point)", "network",
+                              "give a track that joins two different points")
     if rate is not None:  # the vertiport variant: take-off from and landing to the ground (z = 0) below P_O, P_D
         network = {name: with_vertical_phases(wp) for name, wp in network.items()}
     for a, b in routes:
