@@ -46,6 +46,16 @@ def _browser():
     return webdriver.Chrome(service=Service(DRIVER), options=o)
 
 
+def _rendered(driver, tries: int) -> bool:
+    """Wait for the first render (plotly has drawn its WebGL scene), polling every 0.25 s."""
+    for _ in range(tries):
+        if driver.execute_script("var g = document.querySelector('.js-plotly-plot');"
+                                 "return !!(g && g._fullLayout && document.querySelector('canvas'))"):
+            return True
+        time.sleep(0.25)
+    return False
+
+
 def _pixels(driver) -> np.ndarray:
     import io
 
@@ -78,12 +88,7 @@ def test_the_view_renders_and_plays_offline_in_chromium(page):
     driver = _browser()
     try:
         driver.get(page.as_uri())
-        for _ in range(120):  # the first render: plotly has drawn its WebGL scene
-            if driver.execute_script("var g = document.querySelector('.js-plotly-plot');"
-                                     "return !!(g && g._fullLayout && document.querySelector('canvas'))"):
-                break
-            time.sleep(0.25)
-        else:
+        if not _rendered(driver, tries=120):
             pytest.fail("the view never rendered")
         time.sleep(2.0)
         first = _pixels(driver)

@@ -18,7 +18,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from test_view_browser import _browser
+from test_view_browser import _browser, _rendered
 
 
 def main() -> None:
@@ -30,12 +30,7 @@ def main() -> None:
     driver = _browser()
     try:
         driver.get(args.page.resolve().as_uri())
-        for _ in range(400):
-            if driver.execute_script("var g = document.querySelector('.js-plotly-plot');"
-                                     "return !!(g && g._fullLayout && document.querySelector('canvas'))"):
-                break
-            time.sleep(0.25)
-        else:
+        if not _rendered(driver, tries=400):
             sys.exit("the view never rendered")
         time.sleep(3.0)
         driver.execute_script("var g = document.querySelector('.js-plotly-plot'); var s = g.layout.sliders;"
