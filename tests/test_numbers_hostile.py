@@ -190,3 +190,17 @@ def test_the_plan_guard_lets_an_ordinary_plan_through(tmp_path):
     assert len(flights) == 1200 and len(problem.conflicts) > 0
     need = len(flights) * BYTES_PER_FLIGHT + candidate_count(flights) * BYTES_PER_WINDOW_PAIR
     assert need < 0.1 * GB  # the estimate of a small plan is small
+
+
+def test_the_schedule_memory_limit_key_acts():
+    """``schedule.memory_limit_gb`` is read: the ordinary 200-aircraft plan above, under a limit of
+    1 kB, is refused before a flight is made, naming the key (with the default limit it is scheduled)."""
+    from uamopt.errors import UamoptError
+    from uamopt.pipeline import generate_flights, scenario_grid
+    from uamopt.scenario import load_scenario
+    from uamopt.schedule.plan import straight_network
+
+    scenario = load_scenario(PAPER_CASE, ["grid.cell=[250,250,60]", "schedule.aircraft=200",
+                                          "schedule.memory_limit_gb=1e-6"])
+    with pytest.raises(UamoptError, match="schedule.memory_limit_gb"):
+        generate_flights(scenario, straight_network(scenario, scenario_grid(scenario)))
