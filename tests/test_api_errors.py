@@ -171,3 +171,54 @@ def test_plot_sweep_wrong_type(bad):
     """Was: AttributeError "'NoneType' object has no attribute 'columns'"."""
     with pytest.raises(TypeError, match=rf"plot_sweep\(\): table must be a DataFrame, got {type(bad).__name__}"):
         ua.plot_sweep(bad)
+
+
+# --- the second pass (each was accepted silently or ended in a raw exception on 31937a6) -----------
+
+
+def test_planning_model_field_of_a_scenario_with_other_risk_settings(scenario):
+    """Same name and cells, other [risk] settings: the field's summary digests tell them apart."""
+    other = ua.load_scenario(PAPER_CASE, ["risk.weights=[0.2,0.3,0.5]"])
+    field = ua.compute_risk(other)
+    with pytest.raises(ua.UamoptError, match=r"another scenario: its \[risk\] settings differ") as info:
+        ua.planning_model(scenario, field)
+    one_line(info.value)
+
+
+def test_a_saved_field_of_other_settings_is_recognised_after_loading(scenario, tmp_path):
+    """The digests travel through summary.json: a field written and read back is still recognised."""
+    from uamopt.io import save_risk
+
+    other = ua.load_scenario(PAPER_CASE, ["aircraft.empty_mass_kg=350"])
+    save_risk(ua.compute_risk(other), tmp_path / "risk")
+    loaded = ua.load_risk(tmp_path / "risk")
+    with pytest.raises(ua.UamoptError, match=r"\[aircraft\] settings differ"):
+        ua.planning_model(scenario, loaded)
+    ua.planning_model(other, loaded)  # its own scenario still plans
+
+
+@pytest.mark.parametrize("bad", [3, None, 2.5])
+def test_solver_profile_wrong_type(bad):
+    """Was: a raw AttributeError/TypeError from deep in load_profile."""
+    with pytest.raises(TypeError, match=r"solver_profile\(\): profile must be"):
+        ua.solver_profile(bad)
+
+
+def test_solve_with_a_profile_of_the_wrong_type(small_problem):
+    with pytest.raises(TypeError, match="profile must be"):
+        ua.solve(small_problem, 3)
+
+
+def test_build_problem_zero_weights(flights, scenario):
+    """Was accepted silently: (0, 0) makes every schedule cost 0."""
+    with pytest.raises(ua.UamoptError, match="not both 0") as info:
+        ua.build_problem(flights, scenario, weights=(0.0, 0.0))
+    one_line(info.value)
+
+
+@pytest.mark.parametrize("key, value", [("risk.weights", "[0,0,0]"), ("tracks.weights", "[0,0]"),
+                                        ("schedule.weights", "[0.0,0.0]")])
+def test_all_zero_scenario_weights_are_refused(key, value):
+    with pytest.raises(ua.ScenarioError, match="weights are all 0") as info:
+        ua.load_scenario(PAPER_CASE, [f"{key}={value}"])
+    one_line(info.value)

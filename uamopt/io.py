@@ -92,6 +92,7 @@ def load_risk(path: str | Path) -> RiskField:
     npz = _file(path, "risk.npz")
     summary = _json(_file(npz.parent, "summary.json"))
     a = read_npz(npz, "regenerate it with `uamopt risk`")
+    _check_risk_numbers(a, summary, npz.parent)
     try:
         grid = AirspaceGrid(cell=tuple(float(c) for c in a["cell"]), shape=a["risk"].shape)  # type: ignore[arg-type]
         city = CityLayers(
@@ -108,7 +109,8 @@ def load_risk(path: str | Path) -> RiskField:
                          risk_U=a["risk_U"], unsafe=a["unsafe"], obstacle=a["obstacle"],
                          band=tuple(summary["band_m"]), constants=constants, threshold=float(rk["threshold_R0"]),  # type: ignore[arg-type]
                          seconds=float(summary.get("seconds", {}).get("risk", 0.0)),
-                         meta={"scenario": summary.get("scenario", ""), "seconds": summary.get("seconds", {})})
+                         meta={"scenario": summary.get("scenario", ""), "seconds": summary.get("seconds", {}),
+                               "inputs": summary.get("inputs") if isinstance(summary.get("inputs"), dict) else {}})
     except (KeyError, ValueError, TypeError) as exc:
         raise InputFileError(f"incomplete risk folder: {exc}", str(npz.parent), "regenerate it with `uamopt risk`") from None
 
@@ -144,6 +146,50 @@ def load_flights(path: str | Path, scenario=None, grid=None, network=None) -> Fl
     return load(_file(path, "flights.json"), scenario, grid, network)
 
 
+#: the arrays of risk.npz that are one value per cell, and the ones that are one value per column
+_RISK_3D = ("risk", "risk_P", "risk_V", "risk_U", "unsafe", "obstacle")
+_RISK_2D = ("surface_height", "building_height", "road_length", "population_density", "shelter", "no_fly")
+
+
+def _check_risk_numbers(a: dict, summary: dict, folder: Path) -> None:
+    """The numbers of a risk folder within what they can mean: the cell, the arrays' shapes (one
+    grid), the risk terms finite or NaN (an obstacle) and ≥ 0, the threshold, band and constants."""
+    from uamopt.bounds import MAX_COORD_M, Range, check_cell, check_number
+
+    where, fix = str(folder), "regenerate it with `uamopt risk`"
+    missing = [name for name in ("cell", *_RISK_3D, *_RISK_2D) if name not in a]
+    if missing:
+        raise InputFileError(f"risk.npz lacks the arrays {', '.join(missing)}", where, fix)
+    check_cell(np.asarray(a["cell"]).tolist(), where, fix)
+    shape = a["risk"].shape
+    if len(shape) != 3 or 0 in shape:
+        raise InputFileError(f"risk.npz's risk is not a 3-D grid (shape {shape})", where, fix)
+    for name in _RISK_3D + _RISK_2D:
+        want = shape if name in _RISK_3D else shape[:2]
+        if a[name].shape != want:
+            raise InputFileError(f"risk.npz's {name} has shape {a[name].shape}, not the grid's {want}", where, fix)
+        values = a[name]
+        if values.dtype.kind == "f":
+            if np.isinf(values).any() or (name not in ("risk", "risk_P", "risk_V", "risk_U") and np.isnan(values).any()):
+                raise InputFileError(f"risk.npz's {name} holds inf or NaN", where, fix)
+            if name != "surface_height" and (values < 0).any():
+                raise InputFileError(f"risk.npz's {name} holds negative values", where, fix)
+        elif values.dtype.kind not in "biu":
+            raise InputFileError(f"risk.npz's {name} is not numeric ({values.dtype})", where, fix)
+    rk = summary.get("risk_per_flight_hour")
+    band = summary.get("band_m")
+    constants = summary.get("constants")
+    if not (isinstance(rk, dict) and isinstance(band, list) and len(band) == 2 and isinstance(constants, dict)):
+        raise InputFileError("summary.json lacks risk_per_flight_hour, band_m or constants", where, fix)
+    check_number(rk.get("threshold_R0"), "summary.json's risk_per_flight_hour.threshold_R0", where, fix, Range(0, 1e6, lo_open=True))
+    low, high = (check_number(b, "summary.json's band_m", where, fix, Range(-MAX_COORD_M, MAX_COORD_M)) for b in band)
+    if low > high:
+        raise InputFileError(f"summary.json's band_m is empty ([{low:g}, {high:g}] m)", where, fix)
+    for key in ("mass_kg", "crash_area_m2", "drag_k_per_m", "terminal_speed_mps", "mean_relative_speed_mps",
+                "vehicle_collision_probability"):
+        check_number(constants.get(key), f"summary.json's constants.{key}", where, fix, Range(0, 1e12))
+
+
 def load_schedule(path: str | Path) -> Schedule:
     """The :class:`~uamopt.schedule.model.Schedule` of a schedule folder (``schedule.csv`` and
     ``summary.json``), rows in schedule.csv order."""
@@ -158,6 +204,7 @@ def load_schedule(path: str | Path) -> Schedule:
             rows = list(csv.DictReader(fh))
         operated = np.array([r["operated"].strip() == "1" for r in rows], dtype=bool)
         delay = np.array([float(r["delay_s"]) for r in rows], dtype=float)
+        _check_schedule_numbers(delay, summary, file.parent)
         return Schedule(
             solver=str(summary["solver"]), status=summary["status"], operated=operated, delay_s=delay,
             objective=summary.get("objective"), bound=summary.get("bound"), gap=summary.get("gap"),
@@ -167,6 +214,24 @@ def load_schedule(path: str | Path) -> Schedule:
     except (KeyError, ValueError, TypeError, AttributeError) as exc:
         raise InputFileError(f"malformed schedule folder: {exc}", str(file.parent),
                              "regenerate it with `uamopt schedule`") from None
+
+
+def _check_schedule_numbers(delay: np.ndarray, summary: dict, folder: Path) -> None:
+    """A schedule folder's numbers within what they can mean (the verifier's ranges)."""
+    from uamopt.bounds import DURATION_S, Range, check_number
+
+    where, fix = str(folder), "regenerate it with `uamopt schedule`"
+    bad = ~((delay >= DURATION_S.lo) & (delay <= DURATION_S.hi))  # NaN too
+    if bad.any():
+        raise InputFileError(f"schedule.csv's delay_s must be {DURATION_S.text()}, got {delay[bad][0]!r} "
+                             f"(row {int(np.flatnonzero(bad)[0]) + 1})", where, fix)
+    for key in ("objective", "bound", "gap"):
+        if summary.get(key) is not None:
+            check_number(summary[key], f"summary.json's {key}", where, fix, Range(-1e15, 1e15))
+    check_number(summary.get("solve_seconds", 0.0), "summary.json's solve_seconds", where, fix, DURATION_S)
+    check_number(summary.get("aircraft", 1), "summary.json's aircraft", where, fix, Range(0, 10**9, integer=True))
+    if summary.get("seed") is not None:
+        check_number(summary["seed"], "summary.json's seed", where, fix, Range(0, 2**63 - 1, integer=True))
 
 
 # --- writers: what the commands write, so every folder loads back with the loaders above -------

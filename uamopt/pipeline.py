@@ -84,7 +84,15 @@ def planning_model(scenario: Scenario, field: RiskField) -> PlanningModel:
 
     expect(scenario, Scenario, "scenario", "planning_model")
     expect(field, RiskField, "field", "planning_model")
+    from uamopt.risk import field_inputs
+
     made_for = field.meta.get("scenario")
+    inputs, expected = field.meta.get("inputs") or {}, field_inputs(scenario)
+    differ = [name for name in expected if name in inputs and inputs[name] != expected[name]]
+    if differ:
+        raise UamoptError(f"the risk field was computed for another scenario: its [{'], ['.join(differ)}] settings "
+                          f"differ from those of {scenario.name!r}", "planning_model(scenario, field)",
+                          "pass the field ua.compute_risk(scenario) returned for this scenario, or recompute it")
     if (made_for is not None and made_for != scenario.name) or tuple(field.grid.cell) != tuple(map(float, scenario.grid.cell)):
         raise UamoptError(f"the risk field was computed for another scenario ({made_for!r}, cells {field.grid.cell}), "
                           f"not {scenario.name!r} (cells {tuple(scenario.grid.cell)})", "planning_model(scenario, field)",
@@ -141,8 +149,8 @@ def build_problem(flights: FlightSet, scenario: Scenario | None = None, *, objec
         if not (isinstance(weights, (list, tuple)) and len(weights) == 2
                 and all(isinstance(w, (int, float)) and not isinstance(w, bool) for w in weights)):
             raise TypeError(f"build_problem(): weights must be a pair of numbers (ω6, ω7), got {weights!r}")
-        if not all(math.isfinite(w) and w >= 0 for w in weights):
-            raise UamoptError(f"the objective weights must be finite numbers ≥ 0, got {tuple(weights)}",
+        if not all(math.isfinite(w) and w >= 0 for w in weights) or not sum(weights) > 0:
+            raise UamoptError(f"the objective weights must be finite numbers ≥ 0, not both 0, got {tuple(weights)}",
                               "build_problem(weights=...)", "give e.g. (0.6, 0.4), as schedule.weights")
     kind = objective or (scenario.schedule.objective if scenario is not None else "weighted")
     return build(flights, scenario, weights=weights, objective=kind)  # type: ignore[arg-type]
@@ -151,8 +159,11 @@ def build_problem(flights: FlightSet, scenario: Scenario | None = None, *, objec
 def solver_profile(profile: SolverProfile | str | Path, **overrides) -> SolverProfile:
     """A profile by name (``highs``), path or object, with ``time_limit_s``, ``seed``,
     ``threads`` or ``options`` replaced."""
+    import os
+
     from uamopt.solvers import SolverProfile, load_profile
 
+    expect(profile, (SolverProfile, str, os.PathLike), "profile", "solver_profile")
     base = profile if isinstance(profile, SolverProfile) else load_profile(profile)
     if "options" in overrides:
         overrides["options"] = {**base.options, **overrides["options"]}

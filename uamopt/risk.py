@@ -251,6 +251,7 @@ class RiskField:
         c = self.constants
         return {
             "scenario": self.meta.get("scenario", ""),
+            "inputs": dict(self.meta.get("inputs", {})),
             "source": self.city.source,
             "attribution": self.city.attribution,
             "crs": self.city.crs,
@@ -362,5 +363,23 @@ def risk_field(scenario: Scenario, grid: AirspaceGrid, city: CityLayers) -> Risk
         grid=grid, city=city, risk=risk, risk_P=risk_p, risk_V=risk_v, risk_U=risk_u,
         unsafe=unsafe, obstacle=obstacle, band=altitude_band(scenario), constants=c,
         threshold=r.threshold, seconds=time.perf_counter() - started,
-        meta={"scenario": scenario.name, "weights": tuple(r.weights)},
+        meta={"scenario": scenario.name, "weights": tuple(r.weights), "inputs": field_inputs(scenario)},
     )
+
+
+#: the scenario sections a risk field is computed from (the grid, the city, the aircraft of A.1-A.5, Eq. 8's weights)
+FIELD_SECTIONS = ("grid", "city", "aircraft", "risk")
+
+
+def field_inputs(scenario: Scenario) -> dict[str, str]:
+    """A digest of each scenario section the field depends on (:data:`FIELD_SECTIONS`), so that a
+    field given with another scenario is recognised (``ua.planning_model``), saved or not."""
+    import hashlib
+    import json
+
+    def digest(name: str) -> str:
+        values = getattr(scenario, name).model_dump(mode="json")
+        values.pop("memory_limit_gb", None)  # a limit on the run, not an input of the field
+        return hashlib.sha256(json.dumps(values, sort_keys=True).encode()).hexdigest()[:16]
+
+    return {name: digest(name) for name in FIELD_SECTIONS}

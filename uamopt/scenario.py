@@ -153,6 +153,13 @@ class AircraftConfig(_Section):
         return value
 
 
+def _not_all_zero(weights: tuple[float, ...]) -> tuple[float, ...]:
+    """Weights of an objective, all 0: every track or schedule would cost the same."""
+    if not any(weights):
+        raise ValueError("the weights are all 0, so every choice would cost the same; give at least one weight > 0")
+    return weights
+
+
 class RiskConfig(_Section):
     """Operational risk model (Sec. 4.1.1, App. A, Table B.3)."""
 
@@ -170,6 +177,7 @@ class RiskConfig(_Section):
     weights: tuple[Weight, Weight, Weight] = Field(
         (0.5, 0.3, 0.2), description="(ω1, ω2, ω3) for people, vehicles, UAVs (Eq. 8)"
     )
+    _weights = field_validator("weights")(lambda value: _not_all_zero(value))
     threshold: Number(0, 1e6, lo_open=True) = Field(1e-7, description="R_0, per flight hour (Eq. 9)")
     quadrature_points: Whole(4, 512) = Field(
         64, description="Gauss-Legendre points per axis for the A.6 average"
@@ -293,6 +301,7 @@ class TracksConfig(_Section):
     """Single-aircraft track planning (Sec. 4.2, 5.1)."""
 
     weights: tuple[Weight, Weight] = Field((0.5, 0.5), description="(ω4, ω5) risk and transport (Eq. 10)")
+    _weights = field_validator("weights")(lambda value: _not_all_zero(value))
     clearance_m: Number(0, 1e4) = Field(50.0, description="s_min, building clearance, m (Eq. 15)")
     buffer_penalty: Number(0, 1e9) = Field(100.0, description="μ, safety-buffer shell penalty (Eq. 35)")
     buffer_measure: Literal["structures", "count", "share"] = Field(
@@ -350,6 +359,7 @@ class ScheduleConfig(_Section):
     """Multi-aircraft scheduling (Sec. 4.3, 5.2)."""
 
     weights: tuple[Weight, Weight] = Field((0.6, 0.4), description="(ω6, ω7) delay and flights (Eq. 20)")
+    _weights = field_validator("weights")(lambda value: _not_all_zero(value))
     outbound_gap_s: Seconds = Field(240.0, description="T_D, s (Eq. 28)")
     return_gap_s: Seconds = Field(360.0, description="T_R, s (Eq. 28)")
     interference: Seconds = Field(0.3, description="χ, interference degree coefficient, s (Eq. 23)")

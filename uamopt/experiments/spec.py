@@ -183,6 +183,11 @@ def _read(path: Path) -> dict:
         raise ScenarioError(f"malformed TOML: {exc}", str(path), "fix the syntax at that line") from None
     except UnicodeDecodeError:
         raise ScenarioError("sweep file is not UTF-8 text", str(path), "save it as UTF-8 TOML") from None
+    except ValueError as exc:  # an integer of more than 4300 digits (Python's int-string limit)
+        from uamopt.bounds import parse_error
+
+        raise ScenarioError(f"the sweep file holds {parse_error(exc)}", str(path),
+                            "every number of a sweep has a range (docs/interfaces.md)") from None
     except RecursionError:
         raise ScenarioError("the sweep file is nested too deeply to read", str(path), "flatten its arrays") from None
     except OSError as exc:
