@@ -3,17 +3,22 @@ PYTHON ?= python3
 VENV   ?= .venv
 PY     := $(VENV)/bin/python
 UAMOPT := $(VENV)/bin/uamopt
+# Every install is pinned to the versions of constraints.txt (pip freeze of a working .venv).
+CONSTRAINTS := constraints.txt
+PIP     = $(PY) -m pip install --quiet -c $(CONSTRAINTS)
+# The base venv: the core and the extras `uamopt reproduce` (make demo) needs: HiGHS and CP-SAT, the 3-D view.
+BASE_EXTRAS ?= exact,view
 
-.PHONY: demo test test-slow test-all bench notebooks notebooks-run clean
+.PHONY: demo lint test test-slow test-all bench notebooks notebooks-run clean
 
-$(VENV)/.base: pyproject.toml
+$(VENV)/.base: pyproject.toml $(CONSTRAINTS)
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet -e .
+	$(PIP) -e '.[$(BASE_EXTRAS)]'
 	touch $@
 
 $(VENV)/.dev: $(VENV)/.base $(VENV)/.browser
-	$(PY) -m pip install --quiet -e '.[dev]'
+	$(PIP) -e '.[dev]'
 	touch $@
 
 # A real browser for tests/test_view_browser.py: Debian's chromium and chromium-driver, installed with
@@ -37,6 +42,11 @@ demo: $(VENV)/.base
 # (a module's fixtures are then built once); TEST_WORKERS=0 runs serially.
 TEST_WORKERS ?= 2
 
+# ruff (ruff.toml) on the library and the tests, mypy with the pydantic plugin (mypy.ini)
+lint: $(VENV)/.dev
+	$(VENV)/bin/ruff check uamopt tests
+	$(VENV)/bin/mypy
+
 test: $(VENV)/.dev
 	$(PY) -m pytest -n $(TEST_WORKERS) --dist loadfile
 
@@ -48,7 +58,7 @@ test-all: $(VENV)/.dev
 	$(PY) -m pytest -n $(TEST_WORKERS) --dist loadfile -m ''
 
 $(VENV)/.notebooks: $(VENV)/.base
-	$(PY) -m pip install --quiet -e '.[notebooks]'
+	$(PIP) -e '.[notebooks]'
 	touch $@
 
 # JupyterLab on the notebooks (full size); the kernel is this venv's Python, cwd the repository root.

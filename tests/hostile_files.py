@@ -294,12 +294,14 @@ def write_numbers(d: Path) -> None:
     (d / "flights_departure_huge.json").write_text(_huge(json.dumps(good), "0.0"), encoding="utf-8")
     net = good_network()
     for name, edit in {"cell_big": lambda doc: doc.__setitem__("cell", [BIG, 250, 60]),
-                       "waypoint_big": lambda doc: doc["routes"]["V1-V2"].__setitem__("waypoints", [[300, 300, BIG], [300, 4220, 290]]),
+                       "waypoint_big": lambda doc: doc["routes"]["V1-V2"].__setitem__("waypoints",
+                                                                                    [[300, 300, BIG], [300, 4220, 290]]),
                        "length_big": lambda doc: doc["routes"]["V1-V2"].__setitem__("length_m", BIG),
                        "layer_inf": lambda doc: doc["routes"]["V1-V2"].__setitem__("layer_k", float("inf"))}.items():
         _json(d / f"net_{name}.json", _tamper(net, edit))
     # schedule folders read by export
-    for name, file, edit in (("departure_big", "flights.json", lambda doc: doc["flights"][0].__setitem__("planned_departure_s", BIG)),
+    for name, file, edit in (("departure_big", "flights.json",
+                              lambda doc: doc["flights"][0].__setitem__("planned_departure_s", BIG)),
                              ("origin_big", "summary.json", lambda doc: doc["frame"].__setitem__("origin", [BIG, 0]))):
         target = d / f"sched_{name}"
         shutil.copytree(d / "good", target)

@@ -21,7 +21,7 @@ from pathlib import Path
 def objective(operated, delay_s, weights, aircraft: int, kind: str = "weighted", upper_s=None) -> float:
     """Eqs. 20-22 (or the lexicographic scalar) of a decision, from plain lists of numbers."""
     flown = [bool(c) for c in operated]
-    total = sum(float(d) for c, d in zip(flown, delay_s) if c)
+    total = sum(float(d) for c, d in zip(flown, delay_s, strict=True) if c)
     served = sum(flown)
     if kind == "lexicographic":
         return -served + total / (sum(float(u) for u in upper_s) + 1.0)

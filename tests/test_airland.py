@@ -43,7 +43,7 @@ def landing_cost(k: int, x) -> float:
     for i in range(len(head)):
         for j in range(i + 1, len(head)):
             assert x[j] >= x[i] + sep[i][j] - 1e-6 or x[i] >= x[j] + sep[j][i] - 1e-6, f"aircraft {i + 1}, {j + 1} too close"
-    return sum(g * max(0.0, t - xi) + h * max(0.0, xi - t) for (_, _, t, _, g, h), xi in zip(head, x))
+    return sum(g * max(0.0, t - xi) + h * max(0.0, xi - t) for (_, _, t, _, g, h), xi in zip(head, x, strict=True))
 
 
 def landing_times(problem, schedule) -> np.ndarray:

@@ -9,9 +9,9 @@ import sys
 import numpy as np
 import pandas as pd
 import pytest
+from conftest import PAPER_CASE
 
 import uamopt as ua
-from conftest import PAPER_CASE
 
 
 def test_import_is_light():
@@ -35,7 +35,7 @@ def stages():
 
 
 def test_stages_and_frames(stages):
-    scenario, field, model, plan, network, flights, problem = stages
+    _scenario, field, _model, plan, network, flights, problem = stages
     summary = field.summary()
     assert summary["cells"] == 50 * 90 * 12 and set(summary["seconds"]) == {"city", "risk", "total"}
     table2 = plan.to_frame()
@@ -95,7 +95,7 @@ def test_folders_load_back(stages, tmp_path):
     from uamopt.io import save_network, save_risk, save_tracks
     from uamopt.schedule.model import write_schedule
 
-    scenario, field, model, plan, network, flights, problem = stages
+    scenario, field, _model, plan, network, flights, problem = stages
     save_risk(field, tmp_path / "risk")
     back = ua.load_risk(tmp_path / "risk")
     for name in ("risk", "risk_P", "risk_V", "risk_U", "unsafe", "obstacle"):
@@ -123,7 +123,7 @@ def test_folders_load_back(stages, tmp_path):
 
 
 def test_loader_errors(tmp_path):
-    with pytest.raises(ua.InputFileError, match="risk.npz not found"):
+    with pytest.raises(ua.InputFileError, match=r"risk\.npz not found"):
         ua.load_risk(tmp_path)
     (tmp_path / "tracks.json").write_text("[1, 2]")
     with pytest.raises(ua.InputFileError, match="JSON object"):

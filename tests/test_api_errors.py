@@ -129,7 +129,7 @@ WRONG_TYPE = [
 
 
 @pytest.mark.parametrize("bad", [None, "models/paper_case.toml", 3])
-@pytest.mark.parametrize("name, before, parameter, expected", WRONG_TYPE)
+@pytest.mark.parametrize(("name", "before", "parameter", "expected"), WRONG_TYPE)
 def test_wrong_type_first_argument(name, before, parameter, expected, bad):
     """Was: AttributeError or TypeError from deep inside ('NoneType' object has no attribute 'grid')."""
     args = (*before, bad, *([None] * 2))[:2] if name in ("planning_model", "generate_flights", "verify") else (*before, bad)
@@ -216,7 +216,7 @@ def test_build_problem_zero_weights(flights, scenario):
     one_line(info.value)
 
 
-@pytest.mark.parametrize("key, value", [("risk.weights", "[0,0,0]"), ("tracks.weights", "[0,0]"),
+@pytest.mark.parametrize(("key", "value"), [("risk.weights", "[0,0,0]"), ("tracks.weights", "[0,0]"),
                                         ("schedule.weights", "[0.0,0.0]")])
 def test_all_zero_scenario_weights_are_refused(key, value):
     with pytest.raises(ua.ScenarioError, match="weights are all 0") as info:

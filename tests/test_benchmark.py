@@ -68,15 +68,15 @@ def test_bench_markdown_and_progress(paper_bench):
     best = table["objective"].min()
     assert "## By solver profile" in text and "best known objective" in text and f"{best:.6g}" in text
     section = text.split("## By solver profile")[1].split("## Runs")[0]
-    summary = [l for l in section.splitlines() if l.startswith("| paper_case | ")]
-    assert [l.split(" | ")[1] for l in summary] == ["greedy", "soa", "highs"]
-    assert [l.split(" | ")[2] for l in summary] == ["delay grid 10 s, heuristic"] * 2 + ["continuous"]  # model
+    summary = [row for row in section.splitlines() if row.startswith("| paper_case | ")]
+    assert [row.split(" | ")[1] for row in summary] == ["greedy", "soa", "highs"]
+    assert [row.split(" | ")[2] for row in summary] == ["delay grid 10 s, heuristic"] * 2 + ["continuous"]  # model
     assert summary[2].split(" | ")[8] == "0"  # HiGHS: distance 0 to the best known
     greedy_distance = float(summary[0].split(" | ")[8])
     assert greedy_distance == pytest.approx(100 * (table[table["profile"] == "greedy"]["objective"].median() - best)
                                             / abs(best), rel=1e-5)
     # not on a terminal: one line per finished solve
-    lines = [l for l in proc.stderr.splitlines() if l.startswith("bench: ")]
+    lines = [line for line in proc.stderr.splitlines() if line.startswith("bench: ")]
     assert len(lines) == 8 and "6/6 solves" in lines[-1] and "paper_case highs seed 1: optimal" in lines[-2]
 
 
@@ -93,8 +93,8 @@ def test_seed_count_instance_name_and_bad_options(tmp_path, capsys):
     table = pd.read_csv(out / "bench.csv")
     assert table["seed"].tolist() == [0, 1, 2]
     assert set(table["instance"]) == {"paper_case[" + ",".join(sets) + "]"} and (table["aircraft"] == 4).all()
-    for args, fragment in ((["--time-limit", "-1"], "time limit must be a positive"), (["--seeds", "1", "1"], "no distinct seeds"),
-                           (["--seeds", "0"], "no distinct seeds")):
+    for args, fragment in ((["--time-limit", "-1"], "time limit must be a positive"),
+                           (["--seeds", "1", "1"], "no distinct seeds"), (["--seeds", "0"], "no distinct seeds")):
         code = main(["bench", str(PAPER), "--solver", "greedy", "--out", str(tmp_path / "bad"), *args])
         err = capsys.readouterr().err
         assert code == 2 and err.startswith("error: ") and fragment in err, err
@@ -155,7 +155,7 @@ def test_progress_lines_when_not_on_a_terminal():
         for i in range(3):
             bar.update(1, f"run {i}")
     assert stream.getvalue().splitlines()[0].startswith("bench: 0/3 solves")
-    assert [l.split(" - ")[-1] for l in stream.getvalue().splitlines()[1:]] == ["run 0", "run 1", "run 2", "done"]
+    assert [line.split(" - ")[-1] for line in stream.getvalue().splitlines()[1:]] == ["run 0", "run 1", "run 2", "done"]
 
 
 def test_progress_bar_on_a_terminal():

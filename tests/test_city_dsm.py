@@ -187,20 +187,20 @@ def test_geographic_crs_rejected(dsm_dir):
 
 def test_no_dsm_given(dsm_dir):
     (dsm_dir / "bare.toml").write_text('[city]\nsource = "dsm"\n')
-    with pytest.raises(ScenarioError, match="city.dsm"):
+    with pytest.raises(ScenarioError, match=r"city\.dsm"):
         dsm_extent(load_scenario(dsm_dir / "bare.toml"))
 
 
 def test_low_patch_is_an_obstacle_but_not_a_clearance_source(dsm_dir):
     """Eq. 15 measures s_min from building cells: a 6 m patch below building_min_height_m = 8 m is an
     obstacle the track cannot enter, but the cell 10 m above it stays admissible."""
-    from uamopt.planning import planning_model
     from uamopt.pipeline import compute_risk
+    from uamopt.planning import planning_model
 
     band = ["aircraft.h_min=0.0", "grid.h_min_airspace=0.0", "city.ground_m=4.0"]
 
     def model(min_height: float):
-        scenario = load_scenario(dsm_dir / "city.toml", band + [f"city.building_min_height_m={min_height}"])
+        scenario = load_scenario(dsm_dir / "city.toml", [*band, f"city.building_min_height_m={min_height}"])
         return planning_model(scenario, compute_risk(scenario))
 
     low = model(8.0)  # the ground between the blocks stands 6 m above the datum: a low patch

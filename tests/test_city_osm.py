@@ -18,7 +18,7 @@ from uamopt.city import load_city, source_extent  # noqa: E402
 from uamopt.city.osm import load_osm, parse_height_m, parse_levels  # noqa: E402
 from uamopt.errors import InputFileError, ScenarioError  # noqa: E402
 from uamopt.grid import AirspaceGrid  # noqa: E402
-from uamopt.pipeline import scenario_grid
+from uamopt.pipeline import scenario_grid  # noqa: E402
 from uamopt.scenario import Scenario, load_scenario  # noqa: E402
 
 HELSINKI = ["city.source=osm", "city.pbf=helsinki"]
@@ -109,7 +109,7 @@ def test_no_fly_lonlat(tmp_path):
     path = tmp_path / "no_fly.geojson"
     path.write_text(json.dumps({"type": "FeatureCollection", "features": [
         {"type": "Feature", "properties": {}, "geometry": {"type": "Polygon", "coordinates": [ring]}}]}))
-    scenario = Scenario().with_overrides(HELSINKI + [f"city.no_fly='{path}'"])
+    scenario = Scenario().with_overrides([*HELSINKI, f"city.no_fly='{path}'"])
     city = load_osm(scenario)
     grid = AirspaceGrid.from_extent((20.0, 20.0, 10.0), (*city.extent, 300.0))
     no_fly = load_city(scenario, grid).no_fly
@@ -120,7 +120,7 @@ def test_no_fly_lonlat(tmp_path):
 
 def test_bbox_crop():
     west, south, east, north = 24.94, 60.168, 24.945, 60.172
-    city = load_osm(Scenario().with_overrides(HELSINKI + [f"city.bbox=[{west},{south},{east},{north}]"]))
+    city = load_osm(Scenario().with_overrides([*HELSINKI, f"city.bbox=[{west},{south},{east},{north}]"]))
     assert 20 < city.notes["buildings"] < 100
     assert city.extent == pytest.approx((278.0, 445.0), rel=0.02)
     assert city.origin == pytest.approx((west, south), abs=1e-6)
@@ -128,7 +128,7 @@ def test_bbox_crop():
 
 def test_bbox_without_buildings():
     with pytest.raises(InputFileError, match="no buildings"):
-        load_osm(Scenario().with_overrides(HELSINKI + ["city.bbox=[10.0,50.0,10.01,50.01]"]))
+        load_osm(Scenario().with_overrides([*HELSINKI, "city.bbox=[10.0,50.0,10.01,50.01]"]))
 
 
 def test_missing_pbf(tmp_path):
@@ -150,7 +150,7 @@ def test_unreadable_pbf(tmp_path):
 
 
 def test_no_pbf_given():
-    with pytest.raises(ScenarioError, match="city.pbf"):
+    with pytest.raises(ScenarioError, match=r"city\.pbf"):
         load_osm(Scenario().with_overrides(["city.source=osm"]))
 
 

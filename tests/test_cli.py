@@ -103,7 +103,7 @@ def test_network_command(tmp_path, capsys):
     assert "network: 20 tracks" in stdout
 
 
-@pytest.mark.parametrize("args, fragment", [
+@pytest.mark.parametrize(("args", "fragment"), [
     (["--from", "300,300,50"], "outside the band"),
     (["--from", "300,300"], "not a point"),
     (["--from", "9000,300,120"], "outside the grid"),
@@ -166,7 +166,7 @@ def bad_toml(tmp_path):
     return write
 
 
-@pytest.mark.parametrize("text, extra, fragment", [
+@pytest.mark.parametrize(("text", "extra", "fragment"), [
     ("[grid\ncell = [1,1,1]", [], "malformed TOML"),
     ("[grid]\ncelll = [10, 10, 10]", [], "unknown key 'grid.celll'"),
     ("[grid]\ncell = [-10, 10, 10]", [], "grid.cell"),

@@ -45,7 +45,7 @@ def robust(problem: SchedulingProblem, unit_s: float) -> SchedulingProblem:
     objective scale: evaluate the robust optimum with the original problem)."""
     fs = problem.flights
     flights = tuple(replace(f, max_delay_s=max(0.0, float(upper) - unit_s), turnaround_after_s=f.turnaround_after_s + unit_s)
-                    for f, upper in zip(fs.flights, fs.delay_upper_s))
+                    for f, upper in zip(fs.flights, fs.delay_upper_s, strict=True))
     c = problem.conflicts
     table = ConflictTable(p=c.p, q=c.q, ptr=c.ptr, intervals=c.intervals + np.array([-unit_s, unit_s]))
     return SchedulingProblem(flights=replace(fs, flights=flights), conflicts=table, weights=problem.weights,

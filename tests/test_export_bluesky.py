@@ -55,7 +55,7 @@ def _commanded(lines, acid):
         if c.startswith(f"ADDWPT {acid} "):
             lat, lon = ends[w[2]] if w[2] in ends else (float(w[2]), float(w[3]))
             points.append((lat, lon, float(w[-2]), float(w[-1])))
-    lat, lon, alt_ft, cas_kt = (np.array(v) for v in zip(*points))
+    lat, lon, alt_ft, cas_kt = (np.array(v) for v in zip(*points, strict=True))
     x, y = hand_local(lon, lat)
     z = alt_ft * FT
     tas = np.array([cas2tas(c * KT, 0.5 * (z[i] + z[i + 1])) for i, c in enumerate(cas_kt[:-1])])  # "from" speeds
@@ -75,8 +75,8 @@ def test_scenario_flies_each_operated_flight_on_a_flyable_trajectory_near_its_pl
     commanded a polyline whose position at every instant is within 8.5 m of the plan's (the
     designed trajectory, ≤ 8.20 m on the paper case's tracks — a regression value of this version's
     tracks, 7.81 m before the corridor points kept inside their cells — plus ≤ 0.3 m of the
-    first-order georeference; the replay's budget e_h = 10 m is the requirement behind it), whose velocity changes by at most g·tan 45° per second, and which reaches the
-    destination at the planned arrival."""
+    first-order georeference; the replay's budget e_h = 10 m is the requirement behind it), whose velocity changes
+    by at most g·tan 45° per second, and which reaches the destination at the planned arrival."""
     readscn = pytest.importorskip("bluesky.stack.simstack").readscn
     lines = readscn(str(scn / "bluesky.scn"))
     assert lines[0] == (0.0, "CASMACHTHR 0")  # before any speed is read

@@ -39,7 +39,7 @@ def test_files_read_back_inside_the_city(exported):
     assert sorted(tracks["id"]) == sorted(f["id"] for f in flights)
     with open(exported / "schedule.csv", newline="", encoding="utf-8") as fh:
         operated = {r["flight"]: r["operated"] == "1" for r in csv.DictReader(fh)}
-    assert tracks.has_z.all() and dict(zip(tracks["id"], tracks["operated"].astype(bool))) == operated
+    assert tracks.has_z.all() and dict(zip(tracks["id"], tracks["operated"].astype(bool), strict=True)) == operated
     first = flights[0]
     coords = np.array(tracks.set_index("id").geometry[first["id"]].coords)
     wp = np.array(first["waypoints"])
@@ -91,7 +91,7 @@ def test_risk_npz_instead_of_recomputing(exported, paper_run, tmp_path):
     assert main(["export", "geojson", str(folder), "--risk", str(tmp_path / "risk.npz")]) == 0
     mine, recomputed = (gpd.read_file(d / "unsafe.geojson") for d in (folder, exported))
     assert list(mine["layer"]) == list(recomputed["layer"])
-    assert all(a.equals(b) for a, b in zip(mine.geometry, recomputed.geometry))
+    assert all(a.equals(b) for a, b in zip(mine.geometry, recomputed.geometry, strict=True))
     assert mine["in_band"].isna().all()  # risk.npz does not record the band
 
 

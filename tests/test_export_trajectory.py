@@ -13,8 +13,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
-from hypothesis import strategies as st
+from hypothesis import given, settings, strategies as st
 
 from uamopt.export.trajectory import ACCEL_SHARE, flyable_trajectory
 
@@ -57,7 +56,7 @@ def test_design_is_flyable_on_time_and_reports_its_exact_error(turns, speed, ban
     """Any level polyline: the design leaves from the plan's first point, arrives on time, never
     accelerates beyond η·g·tan φ, and ``max_error_m`` is its largest distance to the plan."""
     heading, points = 0.0, [np.array([0.0, 0.0, 90.0])]
-    for turn, leg in [(0.0, 200.0)] + turns:
+    for turn, leg in [(0.0, 200.0), *turns]:
         heading += math.radians(turn)
         points.append(points[-1] + leg * np.array([math.cos(heading), math.sin(heading), 0.0]))
     waypoints = np.array(points)

@@ -15,18 +15,18 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-
 from conftest import PAPER_CASE
+
+from uamopt.pipeline import compute_risk
 from uamopt.planning import plan_track, planning_model
 from uamopt.planning.endpoints import PAPER_DESTINATION, PAPER_ORIGIN, default_endpoints
 from uamopt.planning.pareto import weight_sweep
 from uamopt.scenario import load_scenario
-from uamopt.pipeline import compute_risk
 
 
 def _model(side: float, extra: list[str] | None = None):
-    scenario = load_scenario(PAPER_CASE, [f"grid.cell=[{side},{side},{side}]", "grid.extent=[2500.0,4500.0,360.0]"]
-                             + list(extra or []))
+    scenario = load_scenario(PAPER_CASE, [f"grid.cell=[{side},{side},{side}]", "grid.extent=[2500.0,4500.0,360.0]",
+                                          *(extra or [])])
     return planning_model(scenario, compute_risk(scenario))
 
 
@@ -142,6 +142,7 @@ def test_helsinki_reproduce_end_to_end(tmp_path):
     import json
 
     from conftest import ROOT
+
     from uamopt.cli import main
     from uamopt.schedule.verify import verify_dir
 

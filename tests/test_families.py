@@ -6,8 +6,8 @@ from __future__ import annotations
 import dataclasses
 
 import numpy as np
-import pytest
 import pyomo.environ as pyo
+import pytest
 
 import uamopt as ua
 from uamopt.errors import UamoptError
@@ -28,7 +28,7 @@ def test_turnaround_rows_against_the_flights(paper_problem):
     # need = D_e + T_e + ΔT_e − D_f, recomputed from the Flight objects (not the family's arrays)
     fl = paper_problem.flights.flights
     t = paper_problem.turnaround
-    for e, f, need in list(zip(t.e.tolist(), t.f.tolist(), t.need_s.tolist()))[:40]:
+    for e, f, need in list(zip(t.e.tolist(), t.f.tolist(), t.need_s.tolist(), strict=True))[:40]:
         assert fl[e].aircraft == fl[f].aircraft and fl[e].planned_departure_s < fl[f].planned_departure_s
         assert need == pytest.approx(fl[e].planned_departure_s + fl[e].length_m / fl[e].speed_mps
                                      + fl[e].turnaround_after_s - fl[f].planned_departure_s)
@@ -73,7 +73,7 @@ def test_a_family_of_an_unknown_shape_is_refused_by_every_solver(paper_problem):
 
     problem = dataclasses.replace(paper_problem, extra_families=(Holding(),))
     for solver in ("greedy", "highs", "cpsat", "timeindexed", "rolling"):
-        with pytest.raises(UamoptError, match="no encoder for the family 'holding'.*no solver supports"):
+        with pytest.raises(UamoptError, match=r"no encoder for the family 'holding'.*no solver supports"):
             ua.solve(problem, SolverProfile(solver, time_limit_s=5))
 
 

@@ -137,15 +137,15 @@ def test_plot_sweep_any_two_keys_one_line_per_hue_median_and_band():
     table = _schedule_table()
     fig = plot_sweep(table, x="aircraft.cruise_speed_mps", hue="schedule.aircraft")
     assert len(fig.axes) == 2  # the solver varies too: a panel each, not averaged away
-    for ax, solver, less in zip(fig.axes, ("greedy", "soa"), (0.0, 2.0)):
+    for ax, solver, less in zip(fig.axes, ("greedy", "soa"), (0.0, 2.0), strict=True):
         assert f"solver = {solver}" in ax.get_title()
         assert [line.get_label() for line in ax.lines] == ["4", "8"]
-        for line, g in zip(ax.lines, FLEETS):
+        for line, g in zip(ax.lines, FLEETS, strict=True):
             assert line.get_xdata().tolist() == list(SPEEDS)
             assert line.get_ydata().tolist() == pytest.approx([g * v / 10 + 3.0 - less for v in SPEEDS])  # seed 1
         bands = ax.collections
         assert len(bands) == 2
-        for band, g in zip(bands, FLEETS):
+        for band, g in zip(bands, FLEETS, strict=True):
             y = band.get_paths()[0].vertices[:, 1]
             assert (y.min(), y.max()) == pytest.approx((g * 20 / 10 - less, g * 30 / 10 + 6.0 - less))
         assert [t.get_text() for t in ax.get_legend().get_texts()] == ["4", "8"]
@@ -168,7 +168,7 @@ def test_plot_sweep_fulfilment_and_bad_names():
         assert greedy.get_ydata().tolist() == pytest.approx([100 * (6 * g - 1) / (6 * g) for g in FLEETS])
     with pytest.raises(UamoptError, match="no metric 'nonsense'"):
         plot_sweep(table, y="nonsense")
-    with pytest.raises(UamoptError, match="no column 'schedule.nothing'"):
+    with pytest.raises(UamoptError, match=r"no column 'schedule\.nothing'"):
         plot_sweep(table, hue="schedule.nothing")
 
 
@@ -297,7 +297,7 @@ def test_delay_and_gantt_titles_name_the_objective():
 
 def test_three_maps_side_by_side_are_a_b_c(paper_run):
     fig = Figure(figsize=(15, 6.5))
-    for ax, h in zip(fig.subplots(1, 3), (100.0, 160.0, 220.0)):  # notebook 01's Fig. 20
+    for ax, h in zip(fig.subplots(1, 3), (100.0, 160.0, 220.0), strict=True):  # notebook 01's Fig. 20
         plotting.risk(paper_run.field, ax=ax, cruise_altitude_m=h)
     assert [ax.get_title(loc="left")[:4] for ax in fig.axes] == ["(a) ", "(b) ", "(c) "]
     single = Figure()

@@ -57,11 +57,11 @@ def _export(folder):
 def _segment_seconds(flight: dict) -> list[float]:
     """Time of each segment: length / speed_mps; with vertical_rate_mps the first and last at that rate."""
     wp = flight["waypoints"]
-    lengths = [math.sqrt(sum((b - a) ** 2 for a, b in zip(p, q))) for p, q in itertools.pairwise(wp)]
+    lengths = [math.sqrt(sum((b - a) ** 2 for a, b in zip(p, q, strict=True))) for p, q in itertools.pairwise(wp)]
     rates = [flight["speed_mps"]] * len(lengths)
     if "vertical_rate_mps" in flight:
         rates[0] = rates[-1] = flight["vertical_rate_mps"]
-    return [d / v for d, v in zip(lengths, rates)]
+    return [d / v for d, v in zip(lengths, rates, strict=True)]
 
 
 def _expected_times(flight: dict, departure_s: float) -> list[float]:

@@ -39,10 +39,10 @@ def test_edges_match_a_brute_force_enumeration(coarse):
         for d in itertools.product((-1, 0, 1), repeat=3):
             if d == (0, 0, 0):
                 continue
-            n = tuple(a + b for a, b in zip(c, d))
-            if not all(0 <= v < s for v, s in zip(n, shape)):
+            n = tuple(a + b for a, b in zip(c, d, strict=True))
+            if not all(0 <= v < s for v, s in zip(n, shape, strict=True)):
                 continue
-            box_free = all(passable[tuple(a + o for a, o in zip(c, corner))]
+            box_free = all(passable[tuple(a + o for a, o in zip(c, corner, strict=True))]
                            for corner in itertools.product(*[(0, x) if x else (0,) for x in d]))
             assert G.has_edge(c, n) == box_free, (c, n)
             if box_free:

@@ -49,7 +49,7 @@ def test_points_outside():
 )
 def test_index_coordinate_round_trip(cell, shape, frac):
     g = AirspaceGrid(cell=cell, shape=shape)
-    idx = tuple(int(f * n) for f, n in zip(frac, shape))
+    idx = tuple(int(f * n) for f, n in zip(frac, shape, strict=True))
     assert g.index_of(g.centre_of(idx)) == idx
 
 

@@ -5,15 +5,14 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from checks import OBJ_TOL, assert_verified
-from hypothesis import given, settings
-from hypothesis import strategies as st
+from hypothesis import given, settings, strategies as st
 from instances import crossing_problem
 from oracles import objective
 
 from uamopt.errors import UamoptError
 from uamopt.schedule import Flight, FlightSet, build_problem, violations
-from uamopt.solvers import SolverProfile, bruteforce, solve
 from uamopt.schedule.calibration import paper_case_plan
+from uamopt.solvers import SolverProfile, bruteforce, solve
 from uamopt.solvers.genetic import fitness, objective_values
 from uamopt.solvers.greedy import CANCEL, decoder_for, greedy_decisions
 from uamopt.solvers.rolling import pair_matching_bound
@@ -38,7 +37,7 @@ def test_same_route_same_time_forbidden_gap_is_4_s():
     np.testing.assert_allclose(pair.intervals, [[-4.0, 4.0]])
 
 
-@pytest.mark.parametrize("options, delays", [
+@pytest.mark.parametrize(("options", "delays"), [
     ({}, [0.0, 10.0, 20.0]),  # the 4 s gaps rounded up to ΔT_a = 10 s; C clears B (at 10 s) only at 14 s -> 20 s
     ({"step_s": 3.0}, [0.0, 6.0, 12.0]),
     ({"exact_gaps": True}, [0.0, 4.0, 8.0]),
@@ -80,7 +79,7 @@ CROSSING = [
 ]
 
 
-@pytest.mark.parametrize("objective, weights, w_greedy, w_grid, w_optimum", CROSSING)
+@pytest.mark.parametrize(("objective", "weights", "w_greedy", "w_grid", "w_optimum"), CROSSING)
 def test_genetic_beats_greedy_where_greedy_is_suboptimal(objective, weights, w_greedy, w_grid, w_optimum):
     problem = crossing_problem(objective, weights)
     np.testing.assert_allclose([c.intervals[0] for c in problem.conflicts], [[-4.0, 8.0], [4.0, 15.0]])
@@ -186,7 +185,7 @@ def test_fitness_eq36():
     np.testing.assert_allclose(fitness(np.array([2.0, 2.0])), [1.0, 1.0])
 
 
-@pytest.mark.parametrize("solver, options, match", [
+@pytest.mark.parametrize(("solver", "options", "match"), [
     ("greedy", {"step": 10}, "unknown option 'step'"),
     ("greedy", {"step_s": 0}, r"option step_s must be a number in \[0.001, 1e\+07\], got 0"),
     ("soa", {"xi": 1.5}, r"option xi must be a number in \(0, 1\], got 1.5"),

@@ -12,7 +12,8 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 ORDER = ["base", "grid", "city", "risk", "planning", "schedule", "solvers", "commands"]
-LAYER_OF = {"errors": "base", "bounds": "base", "checks": "base", "scenario": "base", "outputs": "base", "interrupts": "base", "lazy": "base", "grid": "grid", "city": "city", "risk": "risk",
+LAYER_OF = {"errors": "base", "bounds": "base", "checks": "base", "scenario": "base", "outputs": "base", "interrupts": "base",
+            "lazy": "base", "optional": "base", "shipped": "base", "grid": "grid", "city": "city", "risk": "risk",
             "planning": "planning", "schedule": "schedule", "solvers": "solvers"}
 
 

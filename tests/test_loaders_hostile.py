@@ -59,7 +59,7 @@ RISK_CASES = [
 ]
 
 
-@pytest.mark.parametrize("name, array, edit, summary, fragment", RISK_CASES, ids=[c[0] for c in RISK_CASES])
+@pytest.mark.parametrize(("name", "array", "edit", "summary", "fragment"), RISK_CASES, ids=[c[0] for c in RISK_CASES])
 def test_a_damaged_risk_folder_is_one_line(risk_folder, tmp_path, name, array, edit, summary, fragment):
     folder = _copy_risk(risk_folder, tmp_path / name, array, edit, summary)
     with pytest.raises(ua.InputFileError) as info:
@@ -121,7 +121,7 @@ SCHEDULE_CASES = [
 ]
 
 
-@pytest.mark.parametrize("name, row, summary, fragment", SCHEDULE_CASES, ids=[c[0] for c in SCHEDULE_CASES])
+@pytest.mark.parametrize(("name", "row", "summary", "fragment"), SCHEDULE_CASES, ids=[c[0] for c in SCHEDULE_CASES])
 def test_a_damaged_schedule_folder_is_one_line(schedule_folder, tmp_path, name, row, summary, fragment):
     folder = _copy_schedule(schedule_folder, tmp_path / name, row, summary)
     with pytest.raises(ua.InputFileError) as info:

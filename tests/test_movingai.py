@@ -54,7 +54,7 @@ def test_map_is_read_with_rows_as_y():
     np.testing.assert_array_equal(octile.passable, [[True, True], [False, True], [False, False]])
 
 
-@pytest.mark.parametrize("text, match", [
+@pytest.mark.parametrize(("text", "match"), [
     ("type octile\nheight 2\nwidth 3\nmap\n...\n..\n", "does not have 2 rows of 3 characters"),  # short row
     ("type octile\nheight 3\nwidth 3\nmap\n...\n...\n", "does not have 3 rows of 3 characters"),  # missing row
     ("type hex\nheight 1\nwidth 1\nmap\n.\n", "has type 'hex'"),

@@ -71,7 +71,7 @@ async def _execute(path: Path, scratch: Path, slots: asyncio.Semaphore, small: b
         started = time.perf_counter()
         try:
             await client.async_execute(env=env)  # raises CellExecutionError on the first failing cell
-        except Exception as error:  # reported by the notebook's own test below
+        except Exception as error:  # noqa: BLE001 - reported by the notebook's own test below
             return nb, time.perf_counter() - started, error
         return nb, time.perf_counter() - started, None
 
@@ -80,7 +80,7 @@ def _execute_all(scratch: Path, small: bool, parallel: int) -> dict:
     async def run_all():
         slots = asyncio.Semaphore(parallel)
         jobs = [_execute(path, scratch / path.stem, slots, small) for path in NOTEBOOKS]
-        return dict(zip((p.name for p in NOTEBOOKS), await asyncio.gather(*jobs)))
+        return dict(zip((p.name for p in NOTEBOOKS), await asyncio.gather(*jobs), strict=True))
 
     return asyncio.run(run_all())
 

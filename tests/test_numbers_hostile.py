@@ -202,5 +202,5 @@ def test_the_schedule_memory_limit_key_acts():
 
     scenario = load_scenario(PAPER_CASE, ["grid.cell=[250,250,60]", "schedule.aircraft=200",
                                           "schedule.memory_limit_gb=1e-6"])
-    with pytest.raises(UamoptError, match="schedule.memory_limit_gb"):
+    with pytest.raises(UamoptError, match=r"schedule\.memory_limit_gb"):
         generate_flights(scenario, straight_network(scenario, scenario_grid(scenario)))

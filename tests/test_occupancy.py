@@ -6,8 +6,7 @@ import itertools
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
-from hypothesis import strategies as st
+from hypothesis import HealthCheck, given, settings, strategies as st
 
 from uamopt.schedule import occupancy
 from uamopt.schedule.flights import Flight, FlightSet
@@ -24,7 +23,7 @@ CUBE = (10.0, 10.0, 10.0)
 
 
 def visits(occ):
-    return [(tuple(c), a, b) for c, a, b in zip(occ.cells.tolist(), occ.t_in.tolist(), occ.t_out.tolist())]
+    return [(tuple(c), a, b) for c, a, b in zip(occ.cells.tolist(), occ.t_in.tolist(), occ.t_out.tolist(), strict=True)]
 
 
 def test_axis_aligned_track_known_times():
@@ -151,7 +150,8 @@ def test_flight_level_join_equals_track_level(radius, monkeypatch):
         track = np.array(base[i % 4], dtype=float)
         if i % 3 == 0:  # a third of the flights get a track of their own
             track[1:-1 if len(track) > 2 else None, :2] += rng.uniform(-4, 4, 2)
-        flights.append(_flight(f"F{i}", f"A{i % 17}", np.clip(track, 0, 100), 100.0 * (i // 17) + float(rng.integers(0, 60)), 25.0))
+        flights.append(_flight(f"F{i}", f"A{i % 17}", np.clip(track, 0, 100), 100.0 * (i // 17) + float(rng.integers(0, 60)),
+                               25.0))
     fs = FlightSet(cell=CUBE, conflict_radius=radius, flights=tuple(flights), service_end_s=10_000.0,
                    outbound_gap_s=0.0, return_gap_s=0.0)
     track_level, flight_level = conflict_table(fs), conflict_table(fs, max_track_pairs=0)

@@ -8,6 +8,7 @@ holds counted by a sweep written here), never from the family's code."""
 from __future__ import annotations
 
 import dataclasses
+import itertools
 import math
 from pathlib import Path
 
@@ -50,7 +51,7 @@ def max_pad_load(problem, schedule, pads: int) -> int:
             continue
         wp = f.waypoints
         climb, descent = (wp[1][2] - wp[0][2]) / 2.5, (wp[-2][2] - wp[-1][2]) / 2.5
-        cruise = sum(math.dist(a, b) for a, b in zip(wp[1:-2], wp[2:-1])) / f.speed_mps
+        cruise = sum(math.dist(a, b) for a, b in itertools.pairwise(wp[1:-1])) / f.speed_mps
         dep = f.planned_departure_s + schedule.delay_s[i]
         arr = dep + climb + cruise + descent
         gap = 240.0 if leg[i] % 2 == 1 else 360.0
@@ -71,12 +72,12 @@ def network(paper_straight_plan):
 def test_vertical_phases_add_the_climb_and_descent_at_the_rate(network):
     _, cruise = plan(network, [])
     _, phased = plan(network, ON)
-    _, slow = plan(network, ON + ["aircraft.vertical_rate_mps=2.0"])
-    for a, b, c in zip(cruise.flights[:4], phased.flights[:4], slow.flights[:4]):
+    _, slow = plan(network, [*ON, "aircraft.vertical_rate_mps=2.0"])
+    for a, b, c in zip(cruise.flights[:4], phased.flights[:4], slow.flights[:4], strict=True):
         alt = a.waypoints[0][2]  # the cruise starts at the cruise altitude above the vertiport
         assert b.waypoints[0].tolist() == [a.waypoints[0][0], a.waypoints[0][1], 0.0]
         assert b.waypoints[-1].tolist() == [a.waypoints[-1][0], a.waypoints[-1][1], 0.0]
-        hand = sum(math.dist(p, q) for p, q in zip(a.waypoints[:-1], a.waypoints[1:])) / 25.0
+        hand = sum(math.dist(p, q) for p, q in itertools.pairwise(a.waypoints)) / 25.0
         assert b.flight_time_s == pytest.approx(hand + 2 * alt / 2.5, abs=1e-9)
         assert c.flight_time_s == pytest.approx(hand + 2 * alt / 2.0, abs=1e-9)  # the rate key acts
 
@@ -92,7 +93,7 @@ def test_default_scenario_has_no_pads_and_no_phases(network):
 def small(network):
     """Four aircraft of the paper-case plan with vertical phases: without pads, with one and with two."""
     scenario, flights = plan(network, ON, aircraft=4)
-    with_pads = {n: build_problem(flights, load_scenario(PAPER_CASE, ON + [f"network.pads={n}"])) for n in (1, 2)}
+    with_pads = {n: build_problem(flights, load_scenario(PAPER_CASE, [*ON, f"network.pads={n}"])) for n in (1, 2)}
     return build_problem(flights, scenario), with_pads
 
 
@@ -118,7 +119,7 @@ def test_a_solver_without_the_cumulative_shape_refuses(small, monkeypatch):
 
     _, pads = small
     monkeypatch.setattr(rolling, "SHAPES", rolling.SHAPES - {"cumulative"})
-    with pytest.raises(UamoptError, match="no encoder for the family 'pads'.*cpsat"):
+    with pytest.raises(UamoptError, match=r"no encoder for the family 'pads'.*cpsat"):
         ua.solve(pads[2], "rolling", time_limit_s=10)
 
 
@@ -156,9 +157,9 @@ def test_cumulative_agrees_with_the_brute_force(tiny_two_pads):
 
 
 def test_pads_of_a_vertiport_override_the_network(network):
-    keys = ON + ["network.pads=1", 'network.vertiports=[{name="V1", x=300.0, y=300.0, pads=3}, '
-                 '{name="V2", x=300.0, y=4220.0}, {name="V3", x=2220.0, y=300.0}, {name="V4", x=2220.0, y=4220.0}, '
-                 '{name="V5", x=1260.0, y=2260.0}]']
+    keys = [*ON, "network.pads=1", 'network.vertiports=[{name="V1", x=300.0, y=300.0, pads=3}, '
+            '{name="V2", x=300.0, y=4220.0}, {name="V3", x=2220.0, y=300.0}, {name="V4", x=2220.0, y=4220.0}, '
+            '{name="V5", x=1260.0, y=2260.0}]']
     scenario = load_scenario(PAPER_CASE, keys)
     assert scenario.network.pads_of() == {"V1": 3, "V2": 1, "V3": 1, "V4": 1, "V5": 1}
     _, flights = plan(network, ON, aircraft=4)
@@ -228,8 +229,9 @@ def test_one_pad_pairs_are_pruned_only_where_two_holds_cannot_meet():
     pruned = family.disjunctive(planned, upper)
     got = {}
     for k in range(len(pruned.p)):
+        rows = slice(pruned.ptr[k], pruned.ptr[k + 1])
         got[(int(pruned.p[k]), int(pruned.q[k]))] = [(float(lo), float(hi)) for lo, hi in
-                                                    zip(pruned.lo[pruned.ptr[k]:pruned.ptr[k + 1]], pruned.hi[pruned.ptr[k]:pruned.ptr[k + 1]])]
+                                                    zip(pruned.lo[rows], pruned.hi[rows], strict=True)]
     want: dict[tuple[int, int], list[tuple[float, float]]] = {}
     for a in range(2 * n):
         for b in range(2 * n):
@@ -259,11 +261,11 @@ def test_the_heuristics_keep_two_pads(network):
     """The decoder (greedy, GA, SOA) keeps at most two aircraft on a two-pad vertiport, counted
     here from the schedule; without the family the same instance puts three on one, so the
     decoder's cumulative check is what keeps them apart. Every schedule is verified."""
-    scenario, flights = plan(network, ON + ["network.routes=[[\"V1\",\"V5\"]]", "schedule.aircraft=6",
-                                            "schedule.flights=12", "schedule.first_departure_window_s=60.0"])
+    scenario, flights = plan(network, [*ON, "network.routes=[[\"V1\",\"V5\"]]", "schedule.aircraft=6",
+                                       "schedule.flights=12", "schedule.first_departure_window_s=60.0"])
     free = build_problem(flights, scenario, objective="lexicographic")
-    two = build_problem(flights, load_scenario(PAPER_CASE, ON + ["network.routes=[[\"V1\",\"V5\"]]",
-                                                              "network.pads=2"]), objective="lexicographic")
+    two = build_problem(flights, load_scenario(PAPER_CASE, [*ON, "network.routes=[[\"V1\",\"V5\"]]",
+                                                            "network.pads=2"]), objective="lexicographic")
     assert len(two.families[[f.name for f in two.families].index("pads")].residual().flight) > 0
     assert max_pad_load(free, ua.solve(free, "greedy"), 2) > 2
     for solver in ("greedy", "ga", "soa"):

@@ -3,7 +3,6 @@ a front whose points do not dominate one another and whose ends are the single-o
 
 from __future__ import annotations
 
-
 import numpy as np
 import pytest
 

@@ -11,6 +11,7 @@ import pytest
 from instances import crossing_problem
 
 from uamopt import plotting
+from uamopt.solvers import SolverProfile, solve
 
 
 def plot_gantt(problem, schedule, path):
@@ -19,7 +20,7 @@ def plot_gantt(problem, schedule, path):
 
 def plot_delay_comparison(problem, schedules, path):
     return plotting.save(plotting.delays(problem, schedules), path)
-from uamopt.solvers import SolverProfile, solve
+
 
 SVG = "{http://www.w3.org/2000/svg}"
 CRIMSON = "#dc143c"  # the delay line of the Gantt chart

@@ -123,7 +123,7 @@ def test_risk_components_one_panel_per_term(paper):
     fig = Figure(figsize=(12, 4))
     axes = fig.subplots(1, 4)
     assert plotting.risk_components(field, axes) is fig
-    for ax, name in zip(axes, ("risk_P", "risk_V", "risk_U", "risk")):
+    for ax, name in zip(axes, ("risk_P", "risk_V", "risk_U", "risk"), strict=True):
         (mean,) = [line for line in ax.lines if line.get_label() == "mean"]
         values = getattr(field, name)
         free = np.isfinite(values).sum(axis=(0, 1))
@@ -143,7 +143,7 @@ def test_tracks_draws_one_line_per_stage(paper):
     fig, ax = _one_axes()
     assert plotting.tracks(plan, model, ax) is fig
     assert len(ax.lines) == len(STAGES) == 4
-    for line, name in zip(ax.lines, STAGES):
+    for line, name in zip(ax.lines, STAGES, strict=True):
         np.testing.assert_array_equal(line.get_xydata(), plan.stages[name].waypoints[:, :2])
         assert colors.to_hex(line.get_color()) == FIG18_COLOURS[name]
     (image,) = ax.images
@@ -159,7 +159,7 @@ def test_tracks_page_and_three_axes(paper):
     assert plotting.tracks(plan, model, axes) is fig
     profile = [line for line in axes[2].lines if colors.to_hex(line.get_color()) in FIG18_COLOURS.values()]
     assert len(profile) == 4  # one altitude profile per stage
-    for line, name in zip(profile, FIG18_COLOURS):
+    for line, name in zip(profile, FIG18_COLOURS, strict=True):
         np.testing.assert_array_equal(line.get_ydata(), plan.stages[name].waypoints[:, 2])
 
 

@@ -56,7 +56,7 @@ def test_inch_grid_keeps_margins_and_gaps_in_inches():
 
 def test_track_geometry_on_hand_cases():
     a, b, c = [0.0, 0.0, 120.0], [1000.0, 0.0, 120.0], [0.0, 800.0, 120.0]
-    tracks = {"A-B": np.array([a, b]), "A-C": np.array([a, c]), "B-A": np.array([b, a]) + [0, 0, 30]}
+    tracks = {"A-B": np.array([a, b]), "A-C": np.array([a, c]), "B-A": np.array([b, a]) + np.array([0, 0, 30])}
     assert pair_directions(tracks, tolerance_m=10.0) == [("A-B", "B-A"), ("A-C", None)]
     np.testing.assert_allclose(along_track_m(np.array([[0, 0, 0], [3, 4, 10], [3, 4, 20]])), [0, 5, 5])
     document = {"routes": {"A-B": {"waypoints": [a, b]}}}  # as network.json holds it

@@ -45,7 +45,7 @@ def test_shipped_profile_loads_as_written_and_solves(path):
         assert schedule.operated_count == 1
 
 
-@pytest.mark.parametrize("text, match", [
+@pytest.mark.parametrize(("text", "match"), [
     ("solver = 'highs'\ntime_limit_s = [1", "malformed TOML"),
     ("solver = 'highs'\ntimelimit = 5", "unknown key 'timelimit'"),
     ("time_limit_s = 5", "missing key 'solver'"),

@@ -4,6 +4,7 @@ Table 4 and Fig. 21 sections show must be the one in the files it claims to summ
 
 from __future__ import annotations
 
+import itertools
 import json
 import re
 from pathlib import Path
@@ -123,7 +124,7 @@ def test_pareto_section_is_a_front(reproduced):
     for points in groups.values():
         # non-dominated: sorted by rising transport cost, the risk cost falls strictly
         assert [c for _, c in points] == sorted(c for _, c in points)
-        assert all(r1 > r2 for (r1, _), (r2, _) in zip(points, points[1:]))
+        assert all(r1 > r2 for (r1, _), (r2, _) in itertools.pairwise(points))
     # the cheapest point without the buffer is the least-transport track: Table 2's shortest track
     shortest = json.loads((reproduced / "tracks.json").read_text())["stages"]["shortest"]
     assert groups["Eq. 10"][0] == (round(shortest["risk_cost"], 1), round(shortest["transport_cost"], 4))

@@ -12,8 +12,10 @@ from uamopt.scenario import Scenario
 
 
 def _reference_vr(a, v_u: float) -> float:
-    f = lambda eps, gam, ve: math.sqrt(ve * ve + v_u * v_u + 2 * ve * v_u * (
-        math.cos(a.climb_angle_rad) * math.cos(gam) * math.cos(eps) - math.sin(a.climb_angle_rad) * math.sin(gam)))
+    def f(eps, gam, ve):
+        return math.sqrt(ve * ve + v_u * v_u + 2 * ve * v_u * (
+            math.cos(a.climb_angle_rad) * math.cos(gam) * math.cos(eps) - math.sin(a.climb_angle_rad) * math.sin(gam)))
+
     total, _ = tplquad(f, a.speed_min_mps, a.speed_max_mps, -math.pi / 2, math.pi / 2, 0, math.pi, epsrel=1e-10)
     return total / (math.pi**2 * (a.speed_max_mps - a.speed_min_mps))
 

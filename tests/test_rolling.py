@@ -82,7 +82,7 @@ def test_tiny_instances_rolling_against_bruteforce(case):
     assert s.objective >= optimum - OBJ_TOL and s.bound <= optimum + OBJ_TOL
 
 
-@pytest.mark.parametrize("options, match", [
+@pytest.mark.parametrize(("options", "match"), [
     ({"bogus": 1}, "unknown option 'bogus'"),
     ({"inner": "ga"}, "option inner = 'ga' is not one of 'cpsat', 'highs'"),
     ({"window_s": 0.0}, r"option window_s must be a number in \[1, 1e\+07\], got 0.0"),

@@ -37,7 +37,7 @@ def test_paper_case_file(root):
     assert len(s.network.vertiports) == 5
 
 
-@pytest.mark.parametrize("item, path, value", [
+@pytest.mark.parametrize(("item", "path", "value"), [
     ("grid.cell=[10,10,10]", ["grid", "cell"], [10, 10, 10]),
     ("city.source=osm", ["city", "source"], "osm"),
     ("city.source='dsm'", ["city", "source"], "dsm"),
@@ -61,7 +61,7 @@ def _write(tmp_path, text):
     return p
 
 
-@pytest.mark.parametrize("text, overrides, fragment", [
+@pytest.mark.parametrize(("text", "overrides", "fragment"), [
     ("[grid\ncell = 1", [], "malformed TOML"),
     ("[grid]\ncel = [1, 1, 1]", [], "unknown key 'grid.cel'"),
     ("[grid]\ncell = [-10, 10, 10]", [], "grid.cell"),
@@ -87,6 +87,6 @@ def test_missing_file(tmp_path):
 
 
 def test_unknown_key_lists_valid_keys(tmp_path):
-    with pytest.raises(ScenarioError, match="unknown key 'risk.lambda'") as info:
+    with pytest.raises(ScenarioError, match=r"unknown key 'risk\.lambda'") as info:
         load_scenario(_write(tmp_path, "[risk]\nlambda = 1"))
     assert "failure_rate_per_h" in info.value.fix

@@ -14,8 +14,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
 from conftest import PAPER_CASE, ROOT
+
 from uamopt import scenario as scenario_module
 from uamopt.cli import main
 
@@ -66,7 +66,7 @@ def test_service_key_changes_eq23(tmp_path, network_file):
 
 
 def test_time_step_key_is_the_delay_and_departure_grid(tmp_path, network_file):
-    summary, rows = schedule(tmp_path, network_file, "schedule.time_step_s=7")
+    _summary, rows = schedule(tmp_path, network_file, "schedule.time_step_s=7")
     delays = [float(r["delay_s"]) for r in rows if r["operated"] == "1"]
     assert any(d > 0 for d in delays)
     assert all(abs(d / 7 - round(d / 7)) < 1e-6 for d in delays)  # greedy's delays on the ΔT_a = 7 s grid
@@ -78,7 +78,7 @@ def test_flights_held_while_speed_varies(tmp_path, network_file):
     """The paper's Fig. 23 keeps 120 flights at every speed; Eq. 23 alone would plan more at 35 m/s,
     and the first-departure window is narrowed (not an error) where a chain has less slack."""
     free, _ = schedule(tmp_path / "free", network_file, "aircraft.cruise_speed_mps=35")
-    held, rows = schedule(tmp_path / "held", network_file, "aircraft.cruise_speed_mps=35", "schedule.flights=120")
+    held, _ = schedule(tmp_path / "held", network_file, "aircraft.cruise_speed_mps=35", "schedule.flights=120")
     assert free["flights"] > 120 and held["flights"] == 120
     tight, _ = schedule(tmp_path / "tight", network_file, "schedule.first_departure_window_s=2000")
     assert any("first_departure_window_s = 2000 s" in n for n in tight["plan_notes"])
@@ -180,7 +180,7 @@ def test_every_scenario_key_is_read(tmp_path, network_file, monkeypatch):
     assert not dead, f"scenario keys never read: {dead}"
 
 
-@pytest.mark.parametrize("override, fragment", [
+@pytest.mark.parametrize(("override", "fragment"), [
     ("grid.cell=[true,true,true]", "must be a number"),
     ("city.seed=true", "valid integer"),
     ('city.seed="7"', "valid integer"),

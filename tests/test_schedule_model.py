@@ -97,7 +97,7 @@ def test_flights_json_round_trip(paper, tmp_path):
     by_route = load_flights(tmp_path / "routes.json", scenario, grid, network=network)
     assert by_route.cell == (25.0, 25.0, 30.0) and by_route.conflict_radius == 0
     np.testing.assert_array_equal(by_route.max_delay_s, fs.max_delay_s)
-    assert all(np.array_equal(a.waypoints, b.waypoints) for a, b in zip(by_route.flights, fs.flights))
+    assert all(np.array_equal(a.waypoints, b.waypoints) for a, b in zip(by_route.flights, fs.flights, strict=True))
 
 
 def _write(tmp_path, raw, name="bad.json"):
@@ -106,7 +106,7 @@ def _write(tmp_path, raw, name="bad.json"):
     return path
 
 
-@pytest.mark.parametrize("case, match", [
+@pytest.mark.parametrize(("case", "match"), [
     ("malformed", "malformed JSON"),
     ("missing", "missing key 'speed_mps'"),
     ("route", "unknown route 'V9-V1'"),
@@ -208,7 +208,8 @@ def test_write_schedule_files(paper, tmp_path):
     assert names == ["flights.json", "schedule.csv", "summary.json"]
     with open(tmp_path / "out" / "schedule.csv", newline="") as fh:
         rows = list(csv.DictReader(fh))
-    assert list(rows[0]) == ["flight", "aircraft", "route", "operated", "planned_departure_s", "delay_s", "departure_s", "arrival_s"]
+    assert list(rows[0]) == ["flight", "aircraft", "route", "operated", "planned_departure_s", "delay_s", "departure_s",
+                             "arrival_s"]
     assert [r["operated"] for r in rows].count("1") == 6 and rows[-1]["departure_s"] == ""
     first = rows[int(problem.chains[0][0])]
     assert float(first["arrival_s"]) == pytest.approx(float(first["departure_s"]) + fs.flight_time_s[0])

@@ -13,13 +13,13 @@ whole bounding box passable, so two cells are joined exactly when they lie in on
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import networkx as nx
 import numpy as np
 import pytest
-from hypothesis import event, find, given, settings
-from hypothesis import strategies as st
+from hypothesis import event, find, given, settings, strategies as st
 from scipy import ndimage
 
 from uamopt.errors import NoTrackError
@@ -40,7 +40,7 @@ def path_cost(problem: SearchProblem, path: np.ndarray) -> float:
     the problem's arrays alone (search.py's module docstring)."""
     cell = np.asarray(problem.cell, dtype=float)
     total = 0.0
-    for u, v in zip(map(tuple, path[:-1]), map(tuple, path[1:])):
+    for u, v in itertools.pairwise(map(tuple, path)):
         step = (np.asarray(v) - np.asarray(u)) * cell
         total += (problem.w_risk * 0.5 * (problem.risk[u] + problem.risk[v]) * math.sqrt(float(step @ step))
                   + problem.c_h * math.hypot(step[0], step[1]) + problem.c_v * abs(step[2]) + problem.penalty[v])
@@ -55,7 +55,7 @@ def assert_valid_track(problem: SearchProblem, result, start, goal) -> None:
     step = np.diff(path, axis=0)
     assert (np.abs(step) <= 1).all() and np.any(step != 0, axis=1).all(), "moves are between 26-neighbours"
     assert problem.passable[tuple(path.T)].all(), "every cell is passable"
-    for u, d in zip(path[:-1], step):
+    for u, d in zip(path[:-1], step, strict=True):
         lo, hi = np.minimum(u, u + d), np.maximum(u, u + d) + 1
         box = problem.passable[lo[0]:hi[0], lo[1]:hi[1], lo[2]:hi[2]]
         assert box.all(), f"move {u.tolist()} → {(u + d).tolist()} cuts the corner of an impassable cell"
@@ -166,7 +166,7 @@ def cost_to_goal(problem: SearchProblem, goal) -> dict:
 
 def check_random_city(city) -> None:
     problem, start, goal = city
-    searches = SEARCHES + (("networkx", "transport"), ("networkx", "relaxed"))
+    searches = (*SEARCHES, ("networkx", "transport"), ("networkx", "relaxed"))
     if not connected(problem.passable, start, goal):
         event("goal walled off")
         for backend, heuristic in searches:

@@ -82,7 +82,7 @@ def test_bruteforce_agrees_on_a_tiny_instance():
 
 
 def test_the_verifier_checks_the_recorded_spacing(pair, tmp_path):
-    plain, spaced = pair
+    plain, _spaced = pair
     free = ua.solve(plain, "highs", time_limit_s=60)
     folder = tmp_path / "s"
     ua.schedule.write_schedule(folder, plain, free)
@@ -98,5 +98,5 @@ def test_the_verifier_checks_the_recorded_spacing(pair, tmp_path):
 
 def test_rolling_refuses_the_family(pair):
     _, spaced = pair
-    with pytest.raises(UamoptError, match="family 'departure_spacing'.*highs"):
+    with pytest.raises(UamoptError, match=r"family 'departure_spacing'.*highs"):
         ua.solve(spaced, "rolling")

@@ -5,7 +5,6 @@ crossing (hand-reasoned below), through the independent verifier, and on the pap
 from __future__ import annotations
 
 import csv
-import dataclasses
 import json
 from pathlib import Path
 
@@ -103,7 +102,7 @@ def test_speed_options_are_checked_and_refused_where_they_cannot_act(paper_probl
     with pytest.raises(UamoptError):
         load_scenario("models/paper_case.toml", ["schedule.speed_options=[]"])
     problem = speed_problem(crossing(), [0.5, 1.0])
-    with pytest.raises(UamoptError, match="speed_turnaround|speed_precedence|speed_choice"):
+    with pytest.raises(UamoptError, match=r"speed_turnaround|speed_precedence|speed_choice"):
         ua.solve(problem, "rolling")
 
 

@@ -25,7 +25,7 @@ def paper(root):
 def test_same_seed_same_city_other_seed_other_city(paper):
     a, b = synthetic_city(paper), synthetic_city(paper)
     assert np.array_equal(a.heights_m, b.heights_m)
-    assert all(x.equals(y) for x, y in zip(a.buildings, b.buildings))
+    assert all(x.equals(y) for x, y in zip(a.buildings, b.buildings, strict=True))
     c = synthetic_city(paper.with_overrides(["city.seed=8"]))
     assert len(c.buildings) != len(a.buildings) or not np.array_equal(c.heights_m, a.heights_m)
 
@@ -41,7 +41,7 @@ def test_city_covers_the_paper_case(paper):
     assert np.median(heights) < 40 and heights.min() >= 6
     # vertiport pads: no building within 60 m, nothing above h_min within the clearance ring
     for v in paper.network.vertiports:
-        for shape, h in zip(city.buildings, heights):
+        for shape, h in zip(city.buildings, heights, strict=True):
             d = shape.distance(box(v.x, v.y, v.x, v.y))
             assert d > 30.0, v.name
             if shape.centroid.distance(box(v.x, v.y, v.x, v.y)) < paper.network.vertiport_clearance_m:
@@ -56,7 +56,7 @@ def test_towers_stand_near_the_long_diagonals(paper):
     ports = {v.name: (v.x, v.y) for v in paper.network.vertiports}
     for a, b in (("V1", "V4"), ("V2", "V3")):
         line = LineString([ports[a], ports[b]]).buffer(200.0)
-        tall = [s for s, h in zip(city.buildings, city.heights_m) if h > 120.0 and s.intersects(line)]
+        tall = [s for s, h in zip(city.buildings, city.heights_m, strict=True) if h > 120.0 and s.intersects(line)]
         assert len(tall) >= 3, (a, b)
 
 

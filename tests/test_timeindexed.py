@@ -20,8 +20,8 @@ from dataclasses import replace
 import numpy as np
 import pytest
 from conftest import PAPER_CASE
-from oracles import objective_from_folder
 from hypothesis import HealthCheck, given, settings
+from oracles import objective_from_folder
 from strategies import tiny_problems
 
 from uamopt.errors import UamoptError
@@ -163,7 +163,8 @@ def test_highs_and_cpsat_in_one_process_either_order(root):
         "pb = build_problem(generate_plan(sc, straight_network(sc, grid), seed=0, aircraft=4), sc)\n"
         "names = sys.argv[1].split(',')\n"
         "res = [solve(pb, SolverProfile(n, time_limit_s=30)) for n in names]\n"
-        "loaded = sorted({m.split('.')[0] for m in sys.modules if m in ('highspy._core', 'ortools.sat.python.cp_model_helper')})\n"
+        "loaded = sorted({m.split('.')[0] for m in sys.modules\n"
+        "                 if m in ('highspy._core', 'ortools.sat.python.cp_model_helper')})\n"
         "print(' '.join(r.status for r in res), res[0].objective - res[1].objective, ','.join(loaded))\n"
     )
     for order in ("cpsat,highs", "highs,cpsat"):

@@ -114,7 +114,7 @@ def test_a_track_along_a_dip_cells_upper_face_is_not_charged_to_the_cell_beyond(
     origin, destination = (5.0, 15.0, 5.0), (25.0, 15.0, 5.0)
     track = exact_equivalent_track(path, (10.0, 10.0, 10.0), origin, destination)
     cells, s0, s1 = polyline_pieces(track, (10.0, 10.0, 10.0))
-    visited = {tuple(c) for c, a, b in zip(cells.tolist(), s0, s1) if b - a > 1e-9}
+    visited = {tuple(c) for c, a, b in zip(cells.tolist(), s0, s1, strict=True) if b - a > 1e-9}
     assert (1, 1, 0) not in visited and visited <= {tuple(c) for c in path.tolist()}
     length = float(np.linalg.norm(np.diff(track, axis=0), axis=1).sum())
     straight = float(np.linalg.norm(np.array([10.0, 10.0, 0.0]) - np.array([5.0, 15.0, 0.0]))) * 2 + 10.0
@@ -133,7 +133,10 @@ def test_the_risk_bound_of_the_corridor_program():
                             scenario=SimpleNamespace(tracks=SimpleNamespace(weights=(0.5, 0.5))))
     origin, destination = (2.0, 2.0, 5.0), (25.0, 28.0, 5.0)
     free, _ = corridor_program(path, cell, origin, destination)
-    carried = lambda t: sum(risk[tuple(c)] * (b - a) for c, a, b in zip(*polyline_pieces(t, cell)))
+
+    def carried(t):
+        return sum(risk[tuple(c)] * (b - a) for c, a, b in zip(*polyline_pieces(t, cell), strict=True))
+
     assert carried(free) > 10.5  # on the slant: longer than straight across
     bounded, info = corridor_program(path, cell, origin, destination, model=model, risk_budget=10.2)
     assert info["risk_bound_active"] and carried(bounded) <= 10.2 + 1e-6
@@ -194,7 +197,7 @@ def test_report_says_every_stage_is_no_riskier_than_the_shortest(paper_model, pa
     assert "Later stages within 2 % of the initial track's C_R (tracks.risk_tolerance): equivalent yes, optimal yes" in text
 
 
-@pytest.mark.parametrize("stage, overrides, hint", [
+@pytest.mark.parametrize(("stage", "overrides", "hint"), [
     ("optimal", [], "tracks.risk_tolerance = 0"),
     ("optimal", ["tracks.equivalent=midpoint"], 'tracks.equivalent = "exact"'),
     ("initial", ["tracks.buffer_measure=count"], 'tracks.buffer_measure = "structures"'),

@@ -11,12 +11,12 @@ from scipy.spatial import cKDTree
 
 from uamopt.errors import UamoptError
 from uamopt.grid.geometry import polyline_pieces
+from uamopt.pipeline import compute_risk
 from uamopt.planning import plan_track, planning_model
 from uamopt.planning.network import load_network, plan_network
-from uamopt.planning.problem import SHORTEST_TIE_BREAK, buffer_cells, buffer_shell_count, box_counts, load_factor, transport_rates
+from uamopt.planning.problem import SHORTEST_TIE_BREAK, box_counts, buffer_cells, buffer_shell_count, load_factor, transport_rates
 from uamopt.planning.tracks import corner_fillets, exact_equivalent_track, midpoint_track
 from uamopt.scenario import Scenario, load_scenario
-from uamopt.pipeline import compute_risk
 
 P_O, P_D = (300.0, 300.0, 120.0), (2220.0, 4220.0, 120.0)
 
@@ -69,7 +69,6 @@ def test_four_stages_and_their_metrics(model, plan):
     # the search's own cost is the stage's Eq. 10 objective plus the buffer exposure
     for name in ("shortest", "initial"):
         s = st_[name]
-        w4, w5 = model.scenario.tracks.weights
         expected = (s.transport_cost + SHORTEST_TIE_BREAK * s.risk_cost if name == "shortest"
                     else s.objective + s.buffer_cost)
         assert s.extra["search_cost"] == pytest.approx(expected, rel=1e-9)
@@ -90,7 +89,7 @@ def _assert_admissible(model, waypoints):
     no-fly zones, and each cell's centre ≥ s_min from every obstacle cell's centre (checked here
     with a k-d tree, independently of the planner's distance transform)."""
     grid = model.field.grid
-    cells, s0, s1 = polyline_pieces(waypoints, grid.cell)
+    cells, _s0, _s1 = polyline_pieces(waypoints, grid.cell)
     low, high = model.field.band
     z_centre = (cells[:, 2] + 0.5) * grid.cell[2]
     assert np.all((z_centre >= low - 1e-9) & (z_centre <= high + 1e-9))
@@ -117,7 +116,10 @@ def test_exact_equivalent_never_longer_than_midpoint(model, seed):
     cells = np.floor(path.waypoints / np.asarray(model.field.grid.cell)).astype(int)
     exact = exact_equivalent_track(cells, model.field.grid.cell, origin, destination)
     mid = midpoint_track(cells, model.field.grid.cell, origin, destination)
-    length = lambda p: float(np.linalg.norm(np.diff(p, axis=0), axis=1).sum())
+
+    def length(p):
+        return float(np.linalg.norm(np.diff(p, axis=0), axis=1).sum())
+
     assert length(exact) <= length(mid) * (1 + 1e-7)
     assert length(exact) >= math.dist(origin, destination) - 1e-6
 
@@ -125,13 +127,16 @@ def test_exact_equivalent_never_longer_than_midpoint(model, seed):
 def test_corner_fillet_is_shorter_than_the_corner():
     pts = np.array([[0.0, 0.0, 0.0], [10.0, 0.0, 0.0], [10.0, 10.0, 5.0]])
     rounded = corner_fillets(pts, np.array([4.0]))
-    length = lambda p: float(np.linalg.norm(np.diff(p, axis=0), axis=1).sum())
+
+    def length(p):
+        return float(np.linalg.norm(np.diff(p, axis=0), axis=1).sum())
+
     assert length(rounded) < length(pts)
     assert np.allclose(rounded[0], pts[0]) and np.allclose(rounded[-1], pts[-1])
     assert np.allclose(corner_fillets(pts, np.array([0.0])), pts)
 
 
-@pytest.mark.parametrize("point, fragment", [
+@pytest.mark.parametrize(("point", "fragment"), [
     ((300.0, 300.0, 50.0), "outside the band"),
     ((300.0, 300.0, 320.0), "outside the band"),
     ((-10.0, 300.0, 120.0), "outside the grid"),
@@ -143,7 +148,7 @@ def test_bad_endpoints(model, point, fragment):
 
 def test_origin_inside_a_building(model):
     tall = np.argwhere(model.field.obstacle[:, :, 4])[0]
-    inside = tuple((tall + 0.5) * np.asarray(model.field.grid.cell[:2])) + (135.0,)
+    inside = (*tuple((tall + 0.5) * np.asarray(model.field.grid.cell[:2])), 135.0)
     with pytest.raises(UamoptError, match="inside a building"):
         plan_track(model, inside, P_D)
 

@@ -99,7 +99,7 @@ def test_an_empty_speed_choice_schedule_is_feasible(tmp_path, capsys):
     assert verify(capsys, folder)[0] == 0
 
 
-@pytest.mark.parametrize("claim, fragment", [
+@pytest.mark.parametrize(("claim", "fragment"), [
     ({"operated": 4, "flights": 4, "aircraft": 2}, "summary.json: operated = 4, the schedule gives 0"),
     ({"flights": 4}, "summary.json: flights = 4, flights.json holds 0"),  # its counts alone claim flights
     ({"aircraft": 2}, "summary.json: aircraft = 2, flights.json holds 0"),
@@ -173,9 +173,9 @@ CASES = [
     ("id-newline-twice", {"flights": NEWLINE_ID, "rows": []}, 2, "appears twice"),
     # schedule.csv
     ("csv-short-row", {"rows": [ROW[:2]]}, 2, "line 2 has fewer fields than the header's 8 columns"),
-    ("csv-departure-400-digits", {"rows": [ROW[:6] + ["9" * 400, "120.0"]]}, 2, "departure_s is not finite"),
-    ("csv-departure-inf", {"rows": [ROW[:6] + ["inf", "120.0"]]}, 2, "departure_s is not finite"),
-    ("csv-departure-early", {"rows": [ROW[:4] + ["100.0", "-150.0", "-50.0", "-30.0"]]}, 1, "before the service start"),
+    ("csv-departure-400-digits", {"rows": [[*ROW[:6], "9" * 400, "120.0"]]}, 2, "departure_s is not finite"),
+    ("csv-departure-inf", {"rows": [[*ROW[:6], "inf", "120.0"]]}, 2, "departure_s is not finite"),
+    ("csv-departure-early", {"rows": [[*ROW[:4], "100.0", "-150.0", "-50.0", "-30.0"]]}, 1, "before the service start"),
     # summary.json
     ("summary-5000-digits", {"summary_text": json.dumps(SUMMARY).replace('"operated": 1', '"operated": ' + "9" * 5000)},
      2, "malformed JSON"),
@@ -207,7 +207,7 @@ def test_a_crafted_folder_ends_in_one_line_or_a_violation(case, tmp_path, capsys
     assert snapshot(tmp_path) == before
 
 
-@pytest.mark.parametrize("text, fragment", [("1e400 10\n", "not an airland file"), ("nan 10\n", "not an airland file"),
+@pytest.mark.parametrize(("text", "fragment"), [("1e400 10\n", "not an airland file"), ("nan 10\n", "not an airland file"),
                                             (None, "not a regular file")])
 def test_a_crafted_airland_file_is_bad_input(text, fragment, tmp_path, capsys):
     """summary.json's separation family names an instance file: its aircraft count is inf or NaN
@@ -224,7 +224,7 @@ def test_a_crafted_airland_file_is_bad_input(text, fragment, tmp_path, capsys):
 def test_a_control_character_in_an_id_stays_on_its_line(tmp_path, capsys):
     """A flight id with a newline (or NUL) in it: each violation is still one line of stdout."""
     flights = [FLIGHT | {"id": "F\n1"}]
-    folder = write_folder(tmp_path / "nl", flights=flights, rows=[["F\x001"] + ROW[1:]], summary=None)
+    folder = write_folder(tmp_path / "nl", flights=flights, rows=[["F\x001", *ROW[1:]]], summary=None)
     code, out, _ = verify(capsys, folder)
     lines = out.splitlines()
     assert code == 1 and len(lines) == 3 and lines[-1] == "2 violations" and "\x00" not in out, lines

@@ -24,8 +24,7 @@ import numpy as np
 import pytest
 from conftest import PAPER_CASE
 from hostile_files import PORTS
-from hypothesis import HealthCheck, event, given, settings
-from hypothesis import strategies as st
+from hypothesis import HealthCheck, event, given, settings, strategies as st
 
 from uamopt.cli import main
 

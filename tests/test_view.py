@@ -135,14 +135,14 @@ def test_the_playback_puts_each_aircraft_where_the_schedule_says(viewed):
         rows = {r["flight"]: r for r in csv.DictReader(fh)}
     seen = set()
     checked = 0
-    for frame, t in zip(frames, clock):
+    for frame, t in zip(frames, clock, strict=True):
         by_route = frame["data"][0]  # the aircraft coloured by route
         ids = [c[0] for c in by_route["customdata"]]  # the hover's flight id
         airborne = {fid for fid, (times, _) in plans.items() if times[0] <= t <= times[-1]}
         assert set(ids) == airborne, t
         xs, ys, zs = (values(by_route[k]) for k in "xyz")
         assert len(xs) == len(ids)
-        for fid, x, y, z in zip(ids, xs, ys, zs):
+        for fid, x, y, z in zip(ids, xs, ys, zs, strict=True):
             times, wp = plans[fid]
             want = [np.interp(t, times, wp[:, k]) for k in range(3)]
             assert [x, y, z] == pytest.approx(want, abs=1e-2), (fid, t)  # float32 in the page: < 1 mm at 3 km
@@ -153,7 +153,7 @@ def test_the_playback_puts_each_aircraft_where_the_schedule_says(viewed):
             assert custom[1:] == [row["aircraft"], row["route"], f"{delay:.1f}"]
         by_delay = frame["data"][1]  # the same aircraft, coloured by their delay
         assert [c[0] for c in by_delay["customdata"]] == ids and values(by_delay["x"]) == xs
-        for fid, value in zip(ids, values(by_delay["marker"]["color"])):
+        for fid, value in zip(ids, values(by_delay["marker"]["color"]), strict=True):
             row = rows[fid]
             assert value == pytest.approx(float(row["departure_s"]) - float(row["planned_departure_s"]), abs=1e-3)
         seen |= set(ids)
@@ -175,7 +175,7 @@ def test_each_aircraft_has_its_tracks_colour(viewed):
     seen = 0
     for frame in figure_frames(text):
         trace = frame["data"][0]
-        for custom, value in zip(trace["customdata"], values(trace["marker"]["color"])):
+        for custom, value in zip(trace["customdata"], values(trace["marker"]["color"]), strict=True):
             assert colour(value) == line[route[custom[0]]], custom
             seen += 1
     assert seen > 100
@@ -228,7 +228,7 @@ def test_a_verifier_rejected_pair_is_drawn_red(tmp_path):
     for frame in figure_frames(text):
         trace = frame["data"][0]
         sizes = values(trace["marker"]["size"]) if isinstance(trace["marker"]["size"], dict) else None
-        for n, (custom, value) in enumerate(zip(trace["customdata"], values(trace["marker"]["color"]))):
+        for n, (custom, value) in enumerate(zip(trace["customdata"], values(trace["marker"]["color"]), strict=True)):
             drawn.setdefault(custom[0], set()).add((colour(value), sizes[n] if sizes else trace["marker"]["size"]))
     red = {fid for fid, seen in drawn.items() if all(c == "#d62728" for c, _ in seen)}
     assert red == set(meta["rejected"]) and {a["flight"], b["flight"]} <= red
@@ -237,7 +237,7 @@ def test_a_verifier_rejected_pair_is_drawn_red(tmp_path):
     assert all(all(c != "#d62728" and s < big for c, s in seen) for fid, seen in drawn.items() if fid not in red)
 
 
-@pytest.mark.parametrize("args, fragment", [
+@pytest.mark.parametrize(("args", "fragment"), [
     (["view", "/nonexistent/folder"], "not a folder"),
     (["view", "{dir}", "--out", "{dir}"], "--out is a folder"),
     (["view", "{dir}", "--out", "{dir}/missing/view.html"], "does not exist"),

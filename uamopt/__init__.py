@@ -23,13 +23,13 @@ from __future__ import annotations
 
 import importlib
 
-from uamopt.errors import (
-    GridError,
-    InfeasibleScheduleError,
-    InputFileError,
-    NoTrackError,
-    ScenarioError,
-    UamoptError,
+from uamopt.errors import (  # re-exported: the "X as X" form marks them public for linters and type checkers
+    GridError as GridError,
+    InfeasibleScheduleError as InfeasibleScheduleError,
+    InputFileError as InputFileError,
+    NoTrackError as NoTrackError,
+    ScenarioError as ScenarioError,
+    UamoptError as UamoptError,
 )
 from uamopt.lazy import lazy_getattr
 

@@ -19,7 +19,7 @@ flight plan may take is a separate guard (``grid.memory_limit_gb``, ``schedule.m
 Traceback (most recent call last):
 ...
 uamopt.errors.InputFileError: speed_mps must be a number in [0.1, 200], got 1000000000000000000000000000000000000000… (401 characters) (flights.json): give m/s
-"""
+"""  # noqa: E501 - the doctest above shows the whole one-line message
 
 from __future__ import annotations
 

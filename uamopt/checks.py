@@ -19,7 +19,8 @@ def _name(types) -> str:
 def expect(value, types, parameter: str, function: str):
     """``value`` if it is an instance of ``types`` (a type or a tuple of types), else
     ``TypeError("function(): parameter must be a T, got U")``."""
-    if isinstance(value, types) and not (isinstance(value, bool) and bool not in (types if isinstance(types, tuple) else (types,))):
+    allowed = types if isinstance(types, tuple) else (types,)
+    if isinstance(value, types) and not (isinstance(value, bool) and bool not in allowed):
         return value
     name = _name(types)
     article = "an" if name[:1].lower() in "aeiou" else "a"

@@ -89,17 +89,19 @@ def cmd_flights(args) -> int:
 
 
 def cmd_schedule(args) -> int:
-    from uamopt.solvers import load_profile
+    from uamopt.solvers import load_profile, solver_module
     from uamopt.workflows import schedule_folder
 
     scenario = _load(args)
     profile = load_profile(args.solver)
+    solver_module(profile.solver)  # a solver of an extra not installed: its one line before any work
     problem, s, problems = schedule_folder(scenario, args.out, profile, args.flights, args.network, args.seed, args.set)
     from uamopt.schedule.families.speed import collapse, speed_choice_of
 
     if speed_choice_of(problem) is not None:  # one row per flight, as schedule.csv (not one per speed copy)
         problem, s = collapse(problem, s)
-    print(f"{s.solver}: {s.status}, {problem.objective_kind} objective {s.objective}, operated {s.operated_count}, cancelled {s.cancelled}, "
+    print(f"{s.solver}: {s.status}, {problem.objective_kind} objective {s.objective}, operated {s.operated_count}, "
+          f"cancelled {s.cancelled}, "
           f"total delay {s.total_delay_s:.1f} s, {s.solve_seconds:.2f} s -> {Path(args.out) / 'schedule.csv'}")
     if problems:  # a solver bug, never bad input: say so loudly
         sys.stderr.write(f"error: the schedule failed verification ({len(problems)} violations, {args.out}): "
@@ -111,9 +113,8 @@ def cmd_schedule(args) -> int:
 def cmd_view(args) -> int:
     import time
 
-    from uamopt.plotting.explore import explore
-
     from uamopt.export.folder import read_schedule_folder
+    from uamopt.plotting.explore import explore
 
     started = time.perf_counter()
     if not (Path(args.dir) / "schedule.csv").is_file() and Path(args.dir).is_dir():
@@ -172,12 +173,15 @@ def cmd_reproduce(args) -> int:
 
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="uamopt", description="Urban Air Mobility risk fields, tracks and schedules.")
-    parser.add_argument("--version", action="version", version="uamopt 0.1.0")
+    from uamopt import __version__
+
+    parser.add_argument("--version", action="version", version=f"uamopt {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
 
     def command(name: str, func, help_text: str, default_out: str, figures: bool = True):
         p = sub.add_parser(name, help=help_text, description=help_text)
-        p.add_argument("scenario", help="scenario TOML file, e.g. models/paper_case.toml")
+        p.add_argument("scenario", help="scenario TOML file, e.g. models/paper_case.toml, or a shipped scenario's name "
+                       "(paper_case)")
         p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                        help="override a scenario key (dotted, TOML value), e.g. grid.cell=[10,10,10]")
         p.add_argument("--out", default=default_out, help=f"output folder (default: {default_out})")
@@ -277,6 +281,55 @@ def _out_of_memory(args, exc: MemoryError) -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
+    """Run one command; returns its exit code (0, 1 for ``verify``'s violations, 2 bad input, 130/143 interrupted)."""
+    if argv is None:  # the process's own command line (the console script)
+        import atexit
+        import signal
+
+        # registered before any library's exit hook, so it runs after them all: what is left of
+        # the shutdown is the interpreter's own teardown, where Python drops its handlers and a
+        # signal would kill the finished command (exit -2 / -15, no line)
+        atexit.register(lambda: [signal.signal(s, signal.SIG_IGN) for s in (signal.SIGINT, signal.SIGTERM)])
+    code = _main(argv)
+    if argv is None:  # the command is over
+        _exit_on_signal(code)
+    return code
+
+
+def _exit_on_signal(code: int) -> None:
+    """A Ctrl-C or SIGTERM while the interpreter shuts down (waiting for library threads, their exit
+    hooks: 0.5 s and more on a loaded machine) finds the command finished: exit with its code at
+    once, instead of a traceback or a finished run killed by the signal with no line."""
+    import os
+    import signal
+
+    def finished(signum, frame) -> None:
+        for stream in (sys.stdout, sys.stderr):
+            try:
+                stream.flush()
+            except Exception:  # noqa: BLE001 - a closed or broken stream: nothing more to say
+                pass
+        os._exit(code)
+
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(sig, finished)
+
+
+def _shipped_files(args) -> None:
+    """A scenario or sweep file that is no file where the command runs but names a shipped one
+    (``paper_case``, ``models/paper_case.toml`` outside a checkout, ``variants/speed``) is the
+    shipped one (:func:`uamopt.shipped.scenario_path`)."""
+    from uamopt.shipped import scenario_path
+
+    for key in ("scenario", "sweep"):
+        value = getattr(args, key, None)
+        if isinstance(value, str):
+            setattr(args, key, str(scenario_path(value)))
+        elif isinstance(value, list):
+            setattr(args, key, [str(scenario_path(v)) if isinstance(v, str) else v for v in value])
+
+
+def _main(argv: list[str] | None) -> int:
     from uamopt.interrupts import install_handlers, interrupt_of
 
     install_handlers()  # SIGTERM cleans up like Ctrl-C (uamopt.interrupts)
@@ -285,10 +338,19 @@ def main(argv: list[str] | None = None) -> int:
         args = build_parser().parse_args(argv)
     except KeyboardInterrupt as exc:
         return _interrupted(None, exc)
+    _shipped_files(args)
     try:
         return args.func(args)
     except UamoptError as exc:
         sys.stderr.write(f"error: {exc.line()}\n")
+        return EXIT_BAD_INPUT
+    except ModuleNotFoundError as exc:  # an optional package imported where no uamopt.optional.need names its extra
+        from uamopt.optional import missing_extra
+
+        missing = missing_extra(exc)
+        if missing is None:
+            raise
+        sys.stderr.write(f"error: {missing.line()}\n")
         return EXIT_BAD_INPUT
     except MemoryError as exc:  # past the memory guards (an address-space limit, ulimit -v): one line, not a traceback
         sys.stderr.write(f"error: {_out_of_memory(args, exc)}\n")

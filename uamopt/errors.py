@@ -49,5 +49,10 @@ class NoTrackError(UamoptError):
     """No admissible track joins the requested origin and destination."""
 
 
+class NoSpaceError(UamoptError):
+    """A write stopped by a full disk, a quota or a file-size limit: the machine's state, not the
+    input, so a sweep stops on it instead of recording the case as failed."""
+
+
 class InfeasibleScheduleError(UamoptError):
     """No schedule satisfies the constraints."""

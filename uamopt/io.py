@@ -75,7 +75,8 @@ def _json(path: Path) -> dict:
     except (ValueError, UnicodeDecodeError, RecursionError) as exc:
         raise InputFileError(f"malformed JSON: {exc}", str(path), "regenerate the folder with uamopt") from None
     except OSError as exc:
-        raise InputFileError(f"cannot read {path.name}: {exc.strerror or exc}", str(path), "check that the file is readable") from None
+        raise InputFileError(f"cannot read {path.name}: {exc.strerror or exc}", str(path),
+                             "check that the file is readable") from None
     if not isinstance(doc, dict):
         raise InputFileError("the file does not hold a JSON object", str(path), "regenerate the folder with uamopt")
     return doc
@@ -181,7 +182,8 @@ def _check_risk_numbers(a: dict, summary: dict, folder: Path) -> None:
     constants = summary.get("constants")
     if not (isinstance(rk, dict) and isinstance(band, list) and len(band) == 2 and isinstance(constants, dict)):
         raise InputFileError("summary.json lacks risk_per_flight_hour, band_m or constants", where, fix)
-    check_number(rk.get("threshold_R0"), "summary.json's risk_per_flight_hour.threshold_R0", where, fix, Range(0, 1e6, lo_open=True))
+    check_number(rk.get("threshold_R0"), "summary.json's risk_per_flight_hour.threshold_R0", where, fix,
+                 Range(0, 1e6, lo_open=True))
     low, high = (check_number(b, "summary.json's band_m", where, fix, Range(-MAX_COORD_M, MAX_COORD_M)) for b in band)
     if low > high:
         raise InputFileError(f"summary.json's band_m is empty ([{low:g}, {high:g}] m)", where, fix)

@@ -39,7 +39,7 @@ from typing import Any
 
 import numpy as np
 
-from uamopt.errors import UamoptError
+from uamopt.errors import NoSpaceError, UamoptError
 from uamopt.interrupts import deferred_signals
 
 try:
@@ -293,7 +293,7 @@ def staged_output(out_dir: str | Path, option: str = "--out") -> Iterator[Path]:
             if exc.errno not in _NO_SPACE:
                 raise
             state = "nothing was written to it" if not staged else "it may hold some of the new files"
-            raise UamoptError(f"cannot write the results: {exc.strerror}", str(out),
+            raise NoSpaceError(f"cannot write the results: {exc.strerror}", str(out),
                               f"free some space or choose a folder on another disk; {state}") from None
         finally:
             with deferred_signals():

@@ -56,14 +56,17 @@ def risk_section(scenario: Scenario, summary: dict) -> str:
         "",
         "| quantity | value |",
         "|---|---|",
-        f"| cells (Δx, Δy, Δz = {', '.join(f'{c:g}' for c in g['cell_m'])} m) | {summary['cells']:,} ({' × '.join(map(str, g['shape']))}) |",
+        f"| cells (Δx, Δy, Δz = {', '.join(f'{c:g}' for c in g['cell_m'])} m) | {summary['cells']:,} "
+        f"({' × '.join(map(str, g['shape']))}) |",
         f"| obstacle cells (inside or below buildings) | {summary['obstacle_cells']:,} |",
         f"| no-fly cells | {summary['no_fly_cells']:,} |",
         f"| unsafe cells (Eq. 9), whole grid | {summary['unsafe_cells']:,} ({100 * summary['unsafe_share']:.1f} %) |",
-        f"| unsafe share of free cells in the band {summary['band_m'][0]:g}–{summary['band_m'][1]:g} m (Eq. 14) | {100 * summary['band_unsafe_share']:.1f} % |",
+        f"| unsafe share of free cells in the band {summary['band_m'][0]:g}–{summary['band_m'][1]:g} m (Eq. 14) | "
+        f"{100 * summary['band_unsafe_share']:.1f} % |",
         f"| columns with road (l_r > 0) | {100 * summary['road_columns_share']:.1f} % |",
         f"| free cells unsafe through R^V alone | {100 * summary['road_driven_unsafe_share']:.1f} % |",
-        f"| R per flight hour over free cells: min / median / max | {rk['min']:.3e} / {rk['median']:.3e} / {rk['max']:.3e} (R_0 = {rk['threshold_R0']:g}) |",
+        f"| R per flight hour over free cells: min / median / max | {rk['min']:.3e} / {rk['median']:.3e} / {rk['max']:.3e} "
+        f"(R_0 = {rk['threshold_R0']:g}) |",
         f"| v_r' (A.6) | {summary['constants']['mean_relative_speed_mps']:.4f} m/s |",
         f"| computed in | {summary['seconds']['risk']:.3f} s (city layers {summary['seconds']['city']:.3f} s) |",
         "",
@@ -230,9 +233,11 @@ def table2_section(scenario: Scenario, model, tracks: dict, title: str = "Track 
     eq = st["equivalent"]
     if mid:
         rule = {"exact Eq. 10 (SOCP)": "exact Eq. 10 optimum in the corridor (SOCP)",
-                "midpoint": "the paper's midpoint rule"}.get(eq.get("rule"), "exact shortest polyline through the corridor (SOCP)")
+                "midpoint": "the paper's midpoint rule"}.get(eq.get("rule"),
+                                                             "exact shortest polyline through the corridor (SOCP)")
         lines += ["", f"Equivalent track, {rule}: {eq['length_m']:.1f} m, "
-                  f"¥{eq['transport_cost']:.4f}; the paper's midpoint rule: {mid['length_m']:.1f} m, ¥{mid['transport_cost']:.4f}."]
+                  f"¥{eq['transport_cost']:.4f}; the paper's midpoint rule: {mid['length_m']:.1f} m, "
+                  f"¥{mid['transport_cost']:.4f}."]
     if paper:
         lines += ["", f"Check of Eq. 12–13: a straight level 4365 m segment with m_p = {scenario.aircraft.payload_kg:g} kg "
                   f"costs ¥{straight_segment_cost(scenario):.4f} (paper's shortest track: ¥27.1527)."]
@@ -259,7 +264,7 @@ def table4_section(scenario: Scenario, results: list, paper: bool = True) -> str
     for side, plan, seconds in results:
         o = plan.stages["optimal"]
         p = PAPER_TABLE4.get(float(side)) if paper else None
-        ref = (lambda i: f" [{p[i]:g}]") if p else (lambda i: "")
+        ref = (lambda i, p=p: f" [{p[i]:g}]") if p else (lambda i: "")
         lines.append(f"| {side:g} m | {o.risk_cost:.1f}{ref(0)} | {o.transport_cost:.4f}{ref(1)} | {o.n_waypoints}{ref(2)} | "
                      f"{o.length_m:.0f} | {seconds:.2f}{ref(3)} |")
     return "\n".join(lines) + "\n\n"
@@ -278,7 +283,7 @@ def network_section(scenario: Scenario, doc: dict) -> str:
     for name, r in doc["routes"].items():
         lines.append(f"| {name} | {r['layer_k'] if r['layer_k'] is not None else '-'} | {r['length_m']:.0f} | "
                      f"{r['transport_cost']:.2f} | {r['risk_cost']:.1f} |")
-    return "\n".join(lines + ["", "![network](network.png)", ""]) + "\n"
+    return "\n".join([*lines, "", "![network](network.png)", ""]) + "\n"
 
 
 def pareto_section(scenario: Scenario, model, fronts: dict, endpoints: tuple[str, str] = ("P_O", "P_D")) -> str:
@@ -304,7 +309,7 @@ def pareto_section(scenario: Scenario, model, fronts: dict, endpoints: tuple[str
     for flag, label in ((False, "Eq. 10"), (True, "Eq. 10 + μ·R(t)")):
         for p in fronts_nd[flag]:
             lines.append(f"| {label} | {p.w4:.4g} | {p.w5:.4g} | {p.risk_cost:.1f} | {p.transport_cost:.4f} |")
-    return "\n".join(lines + ["", "![pareto](pareto.png)", ""]) + "\n"
+    return "\n".join([*lines, "", "![pareto](pareto.png)", ""]) + "\n"
 
 
 def is_paper_schedule(scenario: Scenario, problem) -> bool:
@@ -348,7 +353,7 @@ def table3_section(problem, schedules: dict, verified: dict, suffix: str = "", p
     ]
     for name, s in schedules.items():
         p = PAPER_TABLE3.get(name) if paper else None
-        ref = (lambda i: f" [{p[i]:g}]") if p else (lambda i: "")
+        ref = (lambda i, p=p: f" [{p[i]:g}]") if p else (lambda i: "")
         dist = "-" if best is None or s.objective is None else f"{s.objective - best:+.4f}"
         bound = "-" if s.bound is None else f"{s.bound:.4f}"
         lines.append(f"| {name} | {s.status} | {s.operated_count}{ref(0)} | {s.cancelled}{ref(1)} | "

@@ -12,6 +12,7 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
+from uamopt.optional import require
 from uamopt.scenario import Scenario
 
 REPRODUCE_SOLVERS = ("greedy", "ga", "soa", "highs", "cpsat")
@@ -76,11 +77,13 @@ def reproduce(scenario: Scenario, out: str | Path, overrides: list[str] | None =
     from uamopt.pipeline import compute_risk, plan_network, planning_model
     from uamopt.planning.endpoints import default_endpoints, is_paper_track
     from uamopt.planning.pareto import weight_sweep
-    from uamopt.report import (network_section, pareto_section, risk_section, table2_section, table4_section,
-                               write_report)
+    from uamopt.report import network_section, pareto_section, risk_section, table2_section, table4_section, write_report
     from uamopt.workflows import progress, write_network, write_risk
 
     check_out_dir(out)
+    require("pyomo", "ortools", extra="exact", what="uamopt reproduce (Table 3 runs highs and cpsat)")
+    if figures:
+        require("plotly", extra="view", what="uamopt reproduce's 3-D view (--no-figures leaves it out)")
     t2 = scenario.tracks.table2_cell_m
     sides = [t2] + [c for c in scenario.tracks.table4_cells if c != t2]
     steps = 4 + 2 * len(scenario.network.route_list()) + len(sides) + 2 * len(REPRODUCE_SOLVERS)

@@ -142,7 +142,7 @@ class RiskConstants:
     vehicle_collision_probability: float  # P^V (Eq. 5)
 
     @classmethod
-    def from_scenario(cls, scenario: Scenario) -> "RiskConstants":
+    def from_scenario(cls, scenario: Scenario) -> RiskConstants:
         a, r = scenario.aircraft, scenario.risk
         mass = a.empty_mass_kg + a.payload_kg
         area = crash_area(a.length_m)

@@ -16,8 +16,17 @@ import tomllib
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
-from pydantic import (BaseModel, BeforeValidator, ConfigDict, Field, PrivateAttr, ValidationError, ValidationInfo, field_validator,
-                      model_validator)
+from pydantic import (
+    BaseModel,
+    BeforeValidator,
+    ConfigDict,
+    Field,
+    PrivateAttr,
+    ValidationError,
+    ValidationInfo,
+    field_validator,
+    model_validator,
+)
 
 from uamopt.bounds import INT64_MAX, MAX_COORD_M, MAX_TIME_S, Range, digits, parse_error
 from uamopt.checks import expect_path
@@ -79,7 +88,8 @@ class GridConfig(_Section):
         None, description="(x_max, y_max, z_max), m; omitted: the city's own extent and z_max = h'_max"
     )
     h_min_airspace: Altitude = Field(30.0, description="h'_min, lowest altitude of the airspace, m (Eq. 14)")
-    h_max_airspace: Number(0, MAX_ALTITUDE_M, lo_open=True) = Field(300.0, description="h'_max, highest altitude of the airspace, m (Eq. 14)")
+    h_max_airspace: Number(0, MAX_ALTITUDE_M, lo_open=True) = Field(
+        300.0, description="h'_max, highest altitude of the airspace, m (Eq. 14)")
     memory_limit_gb: Number(0, 1e6, lo_open=True) | None = Field(
         None, description="refuse grids whose run would need more memory than this, GB (about 160 bytes per cell); "
         "omitted: 80 % of the machine's memory, within the address-space limit (ulimit -v)"
@@ -421,7 +431,7 @@ class Scenario(_Section):
     schedule: ScheduleConfig = ScheduleConfig()
 
     @model_validator(mode="after")
-    def _random_vertiports(self) -> "Scenario":
+    def _random_vertiports(self) -> Scenario:
         n = self.network.random_vertiports
         if n is None:
             return self
@@ -444,7 +454,7 @@ class Scenario(_Section):
         path = Path(value).expanduser()
         return path if path.is_absolute() else (self._base_dir / path)
 
-    def with_overrides(self, overrides: list[str]) -> "Scenario":
+    def with_overrides(self, overrides: list[str]) -> Scenario:
         """A copy with ``KEY=VALUE`` overrides applied and validated again."""
         raw = self.model_dump(mode="python")
         return _validate(_apply_overrides(raw, overrides), self._source, self._base_dir, overrides)
@@ -622,10 +632,12 @@ def load_scenario(path: str | Path, overrides: list[str] | None = None) -> Scena
         Missing or malformed file, unknown key, value out of range.
     """
     expect_path(path, "path", "load_scenario")
+    from uamopt.shipped import scenario_path
 
-    path = Path(path)
+    path = Path(scenario_path(path))  # a shipped scenario's name, or models/... outside the checkout
     if not path.is_file():
-        raise ScenarioError(f"scenario file not found: {path}", str(path), "give the path of a .toml scenario, e.g. models/paper_case.toml")
+        raise ScenarioError(f"scenario file not found: {path}", str(path),
+                            "give the path of a .toml scenario, e.g. models/paper_case.toml")
     try:
         raw = tomllib.loads(path.read_text(encoding="utf-8"))
     except tomllib.TOMLDecodeError as exc:

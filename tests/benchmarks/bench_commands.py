@@ -32,12 +32,13 @@ ROOT = Path(__file__).resolve().parents[2]
 UAMOPT = [sys.executable, "-m", "uamopt"]
 CASES = [
     ("python -c pass (peer: process start)", [sys.executable, "-c", "pass"], None),
-    ("import numpy, scipy.ndimage, numba, cvxpy (peer)", [sys.executable, "-c", "import numpy, scipy.ndimage, numba, cvxpy"], None),
-    ("uamopt --help", UAMOPT + ["--help"], 0.5),
-    ("uamopt plan, 50 m, --no-figures", UAMOPT + ["plan", "models/paper_case.toml", "--no-figures", "--out", "{out}"], 2.5),
-    ("uamopt plan, 50 m, figures", UAMOPT + ["plan", "models/paper_case.toml", "--out", "{out}"], None),
-    ("uamopt plan, 10 m, --no-figures", UAMOPT + ["plan", "models/paper_case.toml", "--set", "grid.cell=[10,10,10]",
-                                                  "--no-figures", "--out", "{out}"], 5.0),
+    ("import numpy, scipy.ndimage, numba, cvxpy (peer)", [sys.executable, "-c", "import numpy, scipy.ndimage, numba, cvxpy"],
+     None),
+    ("uamopt --help", [*UAMOPT, "--help"], 0.5),
+    ("uamopt plan, 50 m, --no-figures", [*UAMOPT, "plan", "models/paper_case.toml", "--no-figures", "--out", "{out}"], 2.5),
+    ("uamopt plan, 50 m, figures", [*UAMOPT, "plan", "models/paper_case.toml", "--out", "{out}"], None),
+    ("uamopt plan, 10 m, --no-figures", [*UAMOPT, "plan", "models/paper_case.toml", "--set", "grid.cell=[10,10,10]",
+                                         "--no-figures", "--out", "{out}"], 5.0),
 ]
 
 
@@ -53,7 +54,7 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=3)
     args = parser.parse_args()
-    timed(UAMOPT + ["plan", "models/paper_case.toml", "--no-figures", "--out", "{out}"])  # numba's cache written
+    timed([*UAMOPT, "plan", "models/paper_case.toml", "--no-figures", "--out", "{out}"])  # numba's cache written
     print(f"load average before: {' '.join(f'{x:.2f}' for x in os.getloadavg())}; {os.cpu_count()} cores")
     print(f"{'command':52s} {'fastest':>8s} {'median':>8s} {'target':>7s}")
     failed = 0

@@ -12,8 +12,8 @@ Rungs: ``120`` is the paper case (models/paper_case.toml, seed 0); the others ar
 :func:`ladder_problem` instances — bench_occupancy.py's synthetic city (8 vertiports in a 20 km
 square, straight tracks, 50 × 50 × 30 m cells), 3-hour service for up to 1,000 flights and 9 hours
 for 3,000 (the density of the 1,000-flight rung). ``--ladder toml`` takes the rungs from
-``models/benchmark_*.toml`` instead (planned tracks on the synthetic city; :func:`toml_problem`). Solvers: profile names or paths (``exact`` is
-solvers/exact.toml); ``--time-limit`` overrides every profile's limit.
+``models/benchmark_*.toml`` instead (planned tracks on the synthetic city; :func:`toml_problem`). Solvers: profile
+names or paths (``exact`` is solvers/exact.toml); ``--time-limit`` overrides every profile's limit.
 ``--continuous-bound STEP`` also solves the relaxed time-indexed model (cells of STEP s) for a bound
 valid for continuous delays, with the same time limit.
 """
@@ -32,18 +32,18 @@ ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from bench_occupancy import instance
+from bench_occupancy import instance  # noqa: E402
 
-from uamopt.schedule import build_problem, write_schedule
-from uamopt.schedule.verify import verify_dir
-from uamopt.solvers import SolverProfile, load_profile, solve
+from uamopt.schedule import build_problem, write_schedule  # noqa: E402
+from uamopt.schedule.verify import verify_dir  # noqa: E402
+from uamopt.solvers import SolverProfile, load_profile, solve  # noqa: E402
 
 
 def toml_problem(flights: int):
     """The rung from ``models/benchmark_<flights>.toml`` (the ladder on main): risk field, planned
     network, ``uamopt flights``' generator (``--ladder toml``)."""
-    from uamopt.pipeline import build_problem as pipeline_problem
     from uamopt.pipeline import (
+        build_problem as pipeline_problem,
         compute_risk,
         generate_flights,
         plan_network,
@@ -97,7 +97,8 @@ def run(problem, rung: int, profile: SolverProfile) -> None:
         found = verify_dir(tmp)
     first, best = _times(schedule)
     model = schedule.extras.get("model", schedule.extras.get("bound_of", "-"))
-    print(f"| {rung} | {profile.name or profile.solver} | {schedule.status} | {fmt(schedule.objective)} | {fmt(schedule.bound)} | "
+    print(f"| {rung} | {profile.name or profile.solver} | {schedule.status} | {fmt(schedule.objective)} | "
+          f"{fmt(schedule.bound)} | "
           f"{fmt(schedule.gap, '.2%') if schedule.gap is not None else '-'} | {fmt(first, '.1f')} | {fmt(best, '.1f')} | "
           f"{wall:.1f} | {schedule.operated_count}/{problem.n_flights} | {len(found)} | {load0:.1f}/{os.getloadavg()[0]:.1f} | "
           f"{model} |", flush=True)
@@ -114,7 +115,8 @@ def main() -> None:
     parser.add_argument("--threads", type=int, default=2)
     parser.add_argument("--continuous-bound", type=float, default=0.0, help="cell width s of the relaxed model (0: skip)")
     parser.add_argument("--ladder", choices=["generator", "toml"], default="generator",
-                        help="instances: bench_occupancy's generator (measured in docs/exact_scheduling.md) or models/benchmark_*.toml")
+                        help="instances: bench_occupancy's generator (measured in docs/exact_scheduling.md) "
+                             "or models/benchmark_*.toml")
     args = parser.parse_args()
     print("| flights | solver | status | objective | bound | gap | first s | best s | wall s | operated | violations | "
           "load | model |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|")

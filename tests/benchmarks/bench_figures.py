@@ -29,11 +29,11 @@ def inputs(name: str, cell: float) -> dict:
     """What figure ``name`` draws, for the paper case at cubic-ish cells of ``cell`` m."""
     import numpy as np
 
+    from uamopt.pipeline import compute_risk
     from uamopt.planning import plan_track, planning_model
     from uamopt.planning.network import plan_network
     from uamopt.planning.pareto import weight_sweep
     from uamopt.scenario import load_scenario
-    from uamopt.pipeline import compute_risk
 
     scenario = load_scenario(ROOT / "models" / "paper_case.toml", [f"grid.cell=[{cell},{cell},30.0]"])
     field = compute_risk(scenario)
@@ -135,8 +135,12 @@ def main() -> None:
                    "--cells", args.cells, "--dpi", str(args.dpi)]
         row = json.loads(subprocess.run(command, capture_output=True, text=True, check=True).stdout.splitlines()[-1])
         cold, warm = row["cold"], row["warm"]
-        pair = lambda wall, cpu: f"{wall:.2f} / {cpu:.2f}"
-        print(f"| {name} | {pair(*row['matplotlib'])} | {pair(*row['import'])} | {pair(cold[0], cold[1])} | {pair(cold[2], cold[3])} | "
+
+        def pair(wall, cpu):
+            return f"{wall:.2f} / {cpu:.2f}"
+
+        print(f"| {name} | {pair(*row['matplotlib'])} | {pair(*row['import'])} | {pair(cold[0], cold[1])} | "
+              f"{pair(cold[2], cold[3])} | "
               f"{pair(warm[0], warm[1])} | {pair(warm[2], warm[3])} | {row['size_kb']:.0f} |", flush=True)
 
 

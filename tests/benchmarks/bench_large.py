@@ -4,8 +4,8 @@
     .venv/bin/python tests/benchmarks/bench_large.py day [--flights 10000] [--time-limit 480] [--window 900]
 
 ``medium``: about 1,000 flights (8 vertiports in a 20 km square, a 3-hour service window, the
-instance generator of bench_occupancy.py); greedy, soa, highs and cpsat (``--solvers``; ``rolling`` may be added) each with the time limit:
-objective, bound, gap, seconds, and the independent verifier on the written schedule.
+instance generator of bench_occupancy.py); greedy, soa, highs and cpsat (``--solvers``; ``rolling`` may be added) each
+with the time limit: objective, bound, gap, seconds, and the independent verifier on the written schedule.
 ``day``: bench_occupancy's city-wide day (about 10,000 flights, 12 vertiports, 12 hours) with the
 rolling-horizon solver (inner CP-SAT): total time (target < 10 min), objective, lower bound,
 verified. ``rolling`` is called as a module, so it need not be registered in SOLVERS.
@@ -23,12 +23,11 @@ ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from bench_occupancy import instance
+from bench_occupancy import instance  # noqa: E402
 
-from uamopt.schedule import build_problem, violations, write_schedule
-from uamopt.schedule.verify import verify_dir
-from uamopt.solvers import SolverProfile, rolling
-from uamopt.solvers import solve as run_solver
+from uamopt.schedule import build_problem, violations, write_schedule  # noqa: E402
+from uamopt.schedule.verify import verify_dir  # noqa: E402
+from uamopt.solvers import SolverProfile, rolling, solve as run_solver  # noqa: E402
 
 
 def report(problem, schedule, wall: float) -> None:
@@ -38,7 +37,10 @@ def report(problem, schedule, wall: float) -> None:
         found = verify_dir(tmp)
         t_verify = time.perf_counter() - t0
     model_ok = not violations(problem, schedule.operated, schedule.delay_s)
-    fmt = lambda v: "-" if v is None else f"{v:.4f}"
+
+    def fmt(v):
+        return "-" if v is None else f"{v:.4f}"
+
     print(f"{schedule.solver:8s} {schedule.status:10s} obj {fmt(schedule.objective):>10s} bound {fmt(schedule.bound):>10s} "
           f"gap {fmt(schedule.gap):>8s} operated {schedule.operated_count:5d}/{problem.n_flights} "
           f"delay {schedule.total_delay_s:9.1f} s  solve {schedule.solve_seconds:7.2f} s wall {wall:7.2f} s  "

@@ -31,9 +31,9 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
 
-from uamopt.grid import AirspaceGrid
-from uamopt.scenario import GridConfig, NetworkConfig, Scenario
-from uamopt.schedule import (
+from uamopt.grid import AirspaceGrid  # noqa: E402
+from uamopt.scenario import GridConfig, NetworkConfig, Scenario  # noqa: E402
+from uamopt.schedule import (  # noqa: E402
     build_problem,
     conflict_table,
     flight_occupancies,
@@ -45,9 +45,9 @@ from uamopt.schedule import (
     straight_network,
     write_schedule,
 )
-from uamopt.schedule.occupancy import MAX_TRACK_PAIRS, candidate_pairs, track_pair_gaps
-from uamopt.schedule.flights import track_length_m
-from uamopt.schedule.verify import verify_dir
+from uamopt.schedule.flights import track_length_m  # noqa: E402
+from uamopt.schedule.occupancy import MAX_TRACK_PAIRS, candidate_pairs, track_pair_gaps  # noqa: E402
+from uamopt.schedule.verify import verify_dir  # noqa: E402
 
 
 def instance(n_flights: int, n_vertiports: int, extent_m: float, service_s: float, seed: int = 0):
@@ -83,7 +83,8 @@ def main() -> None:
     if args.distinct:
         rng = np.random.default_rng(1)
         fs = dataclasses.replace(fs, flights=tuple(
-            dataclasses.replace(f, waypoints=np.insert(f.waypoints, 1, f.waypoints.mean(axis=0) + [*rng.uniform(-40, 40, 2), 0], axis=0))
+            dataclasses.replace(f, waypoints=np.insert(f.waypoints, 1, f.waypoints.mean(axis=0)
+                                                       + np.array([*rng.uniform(-40, 40, 2), 0]), axis=0))
             for f in fs.flights))
     t_plan = time.perf_counter() - t0
     print(f"instance: {len(fs):,} flights, {fs.n_aircraft} aircraft, {args.vertiports} vertiports, "

@@ -33,9 +33,9 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
 
-from uamopt import scenario_grid, load_city, load_scenario, risk_field  # noqa: E402
-from uamopt.planning.graph import grid_graph  # noqa: E402
+from uamopt import load_city, load_scenario, risk_field, scenario_grid  # noqa: E402
 from uamopt.planning import SearchProblem, grid_search, plan_track, planning_model  # noqa: E402
+from uamopt.planning.graph import grid_graph  # noqa: E402
 from uamopt.planning.movingai import movingai_problem, read_map, read_scenarios  # noqa: E402
 from uamopt.planning.tracks import endpoint_cell  # noqa: E402
 

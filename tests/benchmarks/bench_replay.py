@@ -31,7 +31,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
 
-from uamopt.sim.replay import replay
+from uamopt.sim.replay import replay  # noqa: E402
 
 SPEED = 25.0
 HEADER = ("| case | trajectory | designed error | max horizontal error | max cross-track | max vertical error "

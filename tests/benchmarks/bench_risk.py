@@ -40,7 +40,8 @@ def per_cell_python(scenario, c: RiskConstants, h: float, cs: float, rho_p: floa
     t = math.acosh(math.exp(c.k_per_m * h)) / math.sqrt(r.gravity_mps2 * c.k_per_m)
     rp = r.failure_rate_per_h * rho_p * c.crash_area_m2 * p
     rv = r.failure_rate_per_h * r.traffic_density_per_m * l_r * c.vehicle_collision_probability
-    ru = r.failure_rate_per_h * r.uav_density_per_m3 * a.wingspan_m * a.height_m * (c.mean_relative_speed_mps * t + a.fuselage_length_m)
+    ru = (r.failure_rate_per_h * r.uav_density_per_m3 * a.wingspan_m * a.height_m
+          * (c.mean_relative_speed_mps * t + a.fuselage_length_m))
     w1, w2, w3 = r.weights
     return w1 * rp + w2 * rv + w3 * ru
 
@@ -91,7 +92,8 @@ def main() -> None:
     print(f"city layers: {t_city:.3f} s")
     print(f"risk field: first {t_first:.3f} s, best of {args.repeat} {best:.3f} s (target < 3 s)")
     print(f"peak memory: process RSS {rss_peak_mb:.0f} MB, traced in risk_field {traced_peak / 2**20:.0f} MB (target < 2048 MB)")
-    print(f"peer (per-cell Python, scaled from {len(sample):,} cells): {t_peer:.1f} s -> vectorised is {t_peer / best:.0f}x faster")
+    print(f"peer (per-cell Python, scaled from {len(sample):,} cells): {t_peer:.1f} s -> vectorised is "
+          f"{t_peer / best:.0f}x faster")
 
 
 if __name__ == "__main__":

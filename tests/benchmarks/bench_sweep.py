@@ -2,16 +2,15 @@
 
     nice -n 10 .venv/bin/python tests/benchmarks/bench_sweep.py [--workers 2] [--cases 16]
 
-Both runs execute the same sweep file (written to a temporary folder: the paper case at 50 m cells,
-``[grid]`` over the number of aircraft and the cruise speed, the preliminary strategy and SOA's
-profile: about 5 CPU seconds a case, so that the cluster's start-up, a few seconds, is amortised) into fresh results folders, one after the other in this process: first with
-``workers = 1`` (serial, the same local-cluster machinery), then with ``--workers``. Printed: the
-wall time of each, the speed-up, a machine check (the same pure-Python loop in ``--workers`` processes at once against one
-after the other: the ceiling any scale-out can reach on the machine as loaded now), the CPU
-seconds the run consumed (this process and its workers) and so the
-cores it actually got on average, the summed per-case solver seconds, the load average before and
-after each run (other processes sharing the cores slow the parallel run more than the serial
-one), and whether the two tables agree row for row (timing aside).
+Both runs execute the same sweep file (written to a temporary folder: the paper case at 50 m cells, ``[grid]`` over
+the number of aircraft and the cruise speed, the preliminary strategy and SOA's profile: about 5 CPU seconds a case,
+so that the cluster's start-up, a few seconds, is amortised) into fresh results folders, one after the other in this
+process: first with ``workers = 1`` (serial, the same local-cluster machinery), then with ``--workers``. Printed: the
+wall time of each, the speed-up, a machine check (the same pure-Python loop in ``--workers`` processes at once against
+one after the other: the ceiling any scale-out can reach on the machine as loaded now), the CPU seconds the run
+consumed (this process and its workers) and so the cores it actually got on average, the summed per-case solver
+seconds, the load average before and after each run (other processes sharing the cores slow the parallel run more than
+the serial one), and whether the two tables agree row for row (timing aside).
 """
 
 from __future__ import annotations

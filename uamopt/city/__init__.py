@@ -15,10 +15,10 @@ if TYPE_CHECKING:
     from uamopt.grid import AirspaceGrid
     from uamopt.scenario import Scenario
 
-__all__ = ["CityLayers", "VectorCity", "load_city", "source_extent", "rasterize_city"]
+__all__ = ["CityLayers", "VectorCity", "load_city", "rasterize_city", "source_extent"]
 
 
-def source_extent(scenario: "Scenario") -> tuple[float, float]:
+def source_extent(scenario: Scenario) -> tuple[float, float]:
     """(x_max, y_max) of the city source in the local frame, m, for a grid with no extent."""
     source = scenario.city.source
     if source == "synthetic":
@@ -34,7 +34,7 @@ def source_extent(scenario: "Scenario") -> tuple[float, float]:
     return dsm_extent(scenario)
 
 
-def load_city(scenario: "Scenario", grid: "AirspaceGrid") -> CityLayers:
+def load_city(scenario: Scenario, grid: AirspaceGrid) -> CityLayers:
     """The scenario's city layers on the grid's columns.
 
     Raises

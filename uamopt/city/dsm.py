@@ -11,7 +11,8 @@ point), then
 - c_s from the Table B.3 height rule, unless ``city.shelter`` gives a c_s GeoTIFF (averaged).
 
 Optional GeoJSON road centre lines (``city.roads``) and no-fly polygons (``city.no_fly``) are in
-the raster's CRS, or say otherwise (a "crs" member, or lon/lat; uamopt/city/geojson.py). Population density is uniform (``city.population_density``).
+the raster's CRS, or say otherwise (a "crs" member, or lon/lat; uamopt/city/geojson.py). Population density is
+uniform (``city.population_density``).
 
 Bounded memory: nothing reads the whole raster. Column maxima and the ground are GDAL warps onto
 the grid's columns, which read only the window under the grid, a chunk at a time; a window of more
@@ -50,7 +51,7 @@ def _open(path: Path, where: str):
         raise InputFileError(f"cannot read GeoTIFF {path}: {exc}", where, "give a valid GeoTIFF raster") from None
 
 
-def _dsm_path(scenario: "Scenario") -> Path:
+def _dsm_path(scenario: Scenario) -> Path:
     if not scenario.city.dsm:
         raise ScenarioError("city.source is 'dsm' but no DSM GeoTIFF is given", "city.dsm",
                             "set city.dsm to the path of a GeoTIFF digital surface model")
@@ -71,7 +72,7 @@ def _check_frame(src, path: Path) -> tuple[float, float, float, float]:
     return tuple(src.bounds)
 
 
-def dsm_extent(scenario: "Scenario") -> tuple[float, float]:
+def dsm_extent(scenario: Scenario) -> tuple[float, float]:
     """(x_max, y_max) of the DSM in the local frame: the raster's width and height, m."""
     path = _dsm_path(scenario)
     with _open(path, "city.dsm") as src:
@@ -79,7 +80,7 @@ def dsm_extent(scenario: "Scenario") -> tuple[float, float]:
     return right - left, top - bottom
 
 
-def dsm_frame(scenario: "Scenario") -> tuple[str, float, float]:
+def dsm_frame(scenario: Scenario) -> tuple[str, float, float]:
     """(CRS, left, bottom): the DSM's projected CRS and the CRS coordinates of the local (0, 0), m."""
     path = _dsm_path(scenario)
     with _open(path, "city.dsm") as src:
@@ -87,7 +88,7 @@ def dsm_frame(scenario: "Scenario") -> tuple[str, float, float]:
         return src.crs.to_string(), float(left), float(bottom)
 
 
-def _on_grid(src, grid: "AirspaceGrid", frame: tuple, resampling: Resampling) -> np.ndarray:
+def _on_grid(src, grid: AirspaceGrid, frame: tuple, resampling: Resampling) -> np.ndarray:
     """Band 1 of ``src`` on the grid's columns, (nx, ny) indexed [i, j] with j northward; NaN outside.
 
     ``frame`` = (crs, left, bottom) of the local frame: the DSM's CRS and its south-west corner, m.
@@ -106,7 +107,7 @@ def _on_grid(src, grid: "AirspaceGrid", frame: tuple, resampling: Resampling) ->
     return np.ascontiguousarray(rows_cols[::-1].T)
 
 
-def _check_window(src, grid: "AirspaceGrid", left: float, bottom: float, limit_gb: float | None) -> None:
+def _check_window(src, grid: AirspaceGrid, left: float, bottom: float, limit_gb: float | None) -> None:
     """Refuse a raster whose window under the grid holds more pixels than memory could (module docstring)."""
     from uamopt.grid.grid import memory_limit_bytes
 
@@ -122,7 +123,7 @@ def _check_window(src, grid: "AirspaceGrid", left: float, bottom: float, limit_g
             "pixels (gdalwarp -tr 5 5 in.tif out.tif) or raise grid.memory_limit_gb")
 
 
-def _refuse_infinite(values: np.ndarray, grid: "AirspaceGrid", path: Path) -> None:
+def _refuse_infinite(values: np.ndarray, grid: AirspaceGrid, path: Path) -> None:
     """Infinite elevations: refused (module docstring), naming the first column that holds one."""
     bad = np.isinf(values)
     if bad.any():
@@ -132,7 +133,7 @@ def _refuse_infinite(values: np.ndarray, grid: "AirspaceGrid", path: Path) -> No
                              f"y = {y:g} m)", "city.dsm", "set those pixels to the raster's nodata value, or fix the DSM")
 
 
-def load_dsm(scenario: "Scenario", grid: "AirspaceGrid") -> CityLayers:
+def load_dsm(scenario: Scenario, grid: AirspaceGrid) -> CityLayers:
     """The scenario's DSM city on the grid's columns.
 
     Returns

@@ -15,8 +15,8 @@ import shapely
 from affine import Affine
 from rasterio import features
 
-from uamopt.grid.geometry import split_segments
 from uamopt.grid import AirspaceGrid
+from uamopt.grid.geometry import split_segments
 from uamopt.scenario import CityConfig
 
 

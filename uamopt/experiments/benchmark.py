@@ -71,10 +71,12 @@ def _instances(problem_or_scenarios) -> dict:
 
 
 def _profiles(solvers, time_limit_s):
-    from uamopt.solvers import SolverProfile, load_profile
+    from uamopt.solvers import SolverProfile, load_profile, solver_module
 
     profiles = [s if isinstance(s, SolverProfile) else load_profile(s)
                 for s in ([solvers] if isinstance(solvers, (str, Path)) else solvers)]
+    for profile in profiles:  # a solver of an extra not installed: its one line, not a table of error rows
+        solver_module(profile.solver)
     if not profiles:
         raise UamoptError("no solver profile given", "benchmark(solvers=...) / --solver",
                           "give at least one profile, e.g. ['greedy', 'highs']")

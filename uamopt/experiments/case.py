@@ -26,6 +26,7 @@ import time
 
 import numpy as np
 
+
 def error_line(exc: BaseException) -> str:
     """An exception as one short line: ``Type: message`` (a UamoptError's own line)."""
     from uamopt.errors import UamoptError
@@ -33,6 +34,20 @@ def error_line(exc: BaseException) -> str:
     text = exc.line() if isinstance(exc, UamoptError) else str(exc)
     first = (text.strip().splitlines() or [""])[0]
     return f"{type(exc).__name__}: {first}"[:400]
+
+
+def _unless_out_of_space(exc: Exception) -> None:
+    """Re-raise a write that a full disk, a quota or a file-size limit stopped (NoSpaceError, or a
+    raw OSError with that errno): the machine's state, not the case's result. The sweep then stops
+    in one line with the cases saved before it, and a resume runs this case again (never a row)."""
+    from uamopt.errors import NoSpaceError
+    from uamopt.experiments.store import NO_SPACE
+
+    if isinstance(exc, NoSpaceError):
+        raise exc
+    if isinstance(exc, OSError) and exc.errno in NO_SPACE:
+        raise NoSpaceError(f"cannot write {exc.filename or 'a temporary file'}: {exc.strerror}", "a sweep case",
+                           "free some space or raise the file size limit (ulimit -f), then run the sweep again") from exc
 
 
 def risk_metrics(scenario, field) -> dict:
@@ -102,6 +117,7 @@ def _schedule_rows(scenario, network, common: dict, solvers, seeds) -> list[dict
         try:
             problem = scheduling_problem(scenario, network, seed)
         except Exception as exc:  # noqa: BLE001 - recorded in the rows
+            _unless_out_of_space(exc)
             rows += [{"solver": p.name, "seed": seed, **common, "status": "error", "error": error_line(exc)} for p in solvers]
             continue
         size = {"flights": problem.n_flights, "aircraft": problem.aircraft_count, "conflicting_pairs": len(problem.conflicts)}
@@ -112,6 +128,7 @@ def _schedule_rows(scenario, network, common: dict, solvers, seeds) -> list[dict
                 schedule = solve(problem, profile, seed=seed)
                 row.update(schedule_row(problem, schedule, time.perf_counter() - t0))
             except Exception as exc:  # noqa: BLE001 - recorded in the row
+                _unless_out_of_space(exc)
                 row.update(status="error", error=error_line(exc))
             rows.append(row)
     return rows
@@ -156,4 +173,5 @@ def run_case(scenario, stage: str, solvers=(), seeds=(0,)) -> list[dict]:
             return [{**common, "status": "ok", "seconds": time.perf_counter() - t0}]
         return _schedule_rows(scenario, network, common, solvers, seeds)
     except Exception as exc:  # noqa: BLE001 - a failing case is a row, not a crash
+        _unless_out_of_space(exc)
         return [{**k, "status": "error", "error": error_line(exc)} for k in keys]

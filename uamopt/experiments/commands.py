@@ -16,7 +16,8 @@ def add_sweep_command(sub) -> None:
                        description="run a sweep file's cases on Dask: results.parquet (resumable); see docs/sweeps.md")
     p.add_argument("sweep", help="sweep TOML file, e.g. models/variants/speed.toml")
     p.add_argument("--out", help="results folder (default: out/sweeps/NAME); re-running into it computes only missing rows")
-    p.add_argument("--scheduler", metavar="ADDRESS", help="a running Dask scheduler, e.g. tcp://127.0.0.1:8786 (default: a local cluster)")
+    p.add_argument("--scheduler", metavar="ADDRESS",
+                   help="a running Dask scheduler, e.g. tcp://127.0.0.1:8786 (default: a local cluster)")
     p.add_argument("--workers", type=int, metavar="N", help="worker processes of the local cluster (default: CPU count)")
     p.add_argument("--small", action="store_true", help="apply the file's [small] table (a fast version)")
     p.set_defaults(func=_cmd_sweep)

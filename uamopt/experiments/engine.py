@@ -37,6 +37,7 @@ from uamopt.experiments.store import (
     typed_frame,
     version,
 )
+from uamopt.optional import require
 
 CONNECT_TIMEOUT_S = 3.0
 
@@ -63,8 +64,14 @@ def connect(scheduler: str | None, workers: int | None, tasks: int, scratch: str
     # Ctrl-C reaches every process of the terminal's group, and the workers printed tracebacks.
     # Processes started while SIGINT is ignored keep ignoring it, so the workers start so; this
     # process takes Ctrl-C again once they run, and stops them (a Ctrl-C during the start is lost).
+    # A SIGTERM during the start is held until the cluster is up, then the cluster is closed and
+    # the SIGTERM acted on: cut inside LocalCluster's start, its clean-up failed an assert of its
+    # own (a worker still in Status.init) and printed that traceback instead of one line.
     main = threading.current_thread() is threading.main_thread()
-    previous = signal.signal(signal.SIGINT, signal.SIG_IGN) if main else None
+    held: list[int] = []
+    if main:
+        previous_int = signal.signal(signal.SIGINT, signal.SIG_IGN)
+        previous_term = signal.signal(signal.SIGTERM, lambda signum, frame: held.append(signum))
     try:
         # every temporary file of the cluster in ``scratch``, removed afterwards even where a worker
         # was stopped mid-task; worker logs muted (a task's error is in its row)
@@ -74,7 +81,13 @@ def connect(scheduler: str | None, workers: int | None, tasks: int, scratch: str
                                    silence_logs=logging.CRITICAL, env={"TMPDIR": scratch})
     finally:
         if main:
-            signal.signal(signal.SIGINT, signal.SIG_DFL if previous is None else previous)
+            signal.signal(signal.SIGINT, signal.SIG_DFL if previous_int is None else previous_int)
+            signal.signal(signal.SIGTERM, signal.SIG_DFL if previous_term is None else previous_term)
+    if held:
+        cluster.close()
+        if callable(previous_term):
+            previous_term(signal.SIGTERM, None)  # raises Terminated (uamopt.interrupts)
+        os.kill(os.getpid(), signal.SIGTERM)  # the default action: end the process
     return Client(cluster), cluster
 
 
@@ -103,7 +116,7 @@ def results_table(spec: SweepSpec, frames: list):
     cols = {"case": "str"} | cols
     frames = [typed_frame(f.to_dict("records"), cols) for f in frames if f is not None and len(f)]
     table = pd.concat(frames, ignore_index=True) if frames else typed_frame([], cols)
-    position = [order.get(row_key(c, s, d), -1) for c, s, d in zip(table["case"], table["solver"], table["seed"])]
+    position = [order.get(row_key(c, s, d), -1) for c, s, d in zip(table["case"], table["solver"], table["seed"], strict=True)]
     table = table.assign(_pos=position)
     table = table[table["_pos"] >= 0].drop_duplicates("_pos", keep="first").sort_values("_pos", kind="stable")
     by_id = {c.id: c for c in spec.cases}
@@ -117,7 +130,8 @@ def results_table(spec: SweepSpec, frames: list):
 def _todo(spec: SweepSpec, done) -> tuple[list, set]:
     """(case, solvers, seeds) of every case lacking a row; a case lacking some rows runs the
     product of its missing solvers and seeds (the rows it already has are dropped afterwards)."""
-    have = set() if done is None else {row_key(c, s, d) for c, s, d in zip(done["case"], done["solver"], done["seed"])}
+    have = set() if done is None else {row_key(c, s, d)
+                                       for c, s, d in zip(done["case"], done["solver"], done["seed"], strict=True)}
     todo = []
     for case in spec.cases:
         if spec.stage != "schedule":
@@ -199,12 +213,14 @@ def sweep(path, out=None, scheduler: str | None = None, workers: int | None = No
     expect_path(path, "path", "sweep")
 
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
-        raise UamoptError(f"--workers must be a whole number ≥ 1, got {workers!r}", "--workers", "give a number of worker processes")
+        raise UamoptError(f"--workers must be a whole number ≥ 1, got {workers!r}", "--workers",
+                          "give a number of worker processes")
     if workers is not None and scheduler:
         raise UamoptError("--workers applies to the local cluster, not to --scheduler", "--workers",
                           "drop --workers (the cluster's workers are started with `dask worker`)")
     from uamopt.outputs import output_lock
 
+    require("distributed", "pyarrow", extra="sweep", what="a sweep (Dask, results.parquet)")
     spec = load_sweep(path, small=small)
     if out is not None:
         with output_lock(out):  # one sweep at a time into a results folder
@@ -236,7 +252,7 @@ def _sweep(spec: SweepSpec, folder: ResultsFolder, scheduler, workers):
             shutil.rmtree(scratch, ignore_errors=True)
     else:
         stats["set_aside"] = folder.start(spec, broken)
-    table = results_table(spec, [folder.read_parts(spec.stage)[0]] + unsaved)
+    table = results_table(spec, [folder.read_parts(spec.stage)[0], *unsaved])
     folder.write_results(table)
     if spec.figure:
         from uamopt.experiments.figures import save_sweep_figure

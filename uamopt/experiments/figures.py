@@ -42,7 +42,8 @@ DERIVED = {"fulfilment": ("planned flights operated (%)", lambda t: 100.0 * _flo
 #: axis labels of the result columns (docs/sweeps.md) and of the keys the paper's studies sweep
 LABELS = {
     "avg_delay_s": "average delay T_d (s, Eq. 21)", "total_delay_s": "total delay Σd (s)",
-    "operated": "flights operated S (Eq. 22)", "cancelled": "flights cancelled", "objective": "objective (schedule.objective: lexicographic or Eq. 20)",
+    "operated": "flights operated S (Eq. 22)", "cancelled": "flights cancelled",
+    "objective": "objective (schedule.objective: lexicographic or Eq. 20)",
     "bound": "bound of the objective", "gap": "gap |objective − bound| / |objective|",
     "seconds": "computing time of the stage (s)", "risk_cost": "operational risk C_R (Eq. 11)",
     "transport_cost": "transport cost C_T (¥, Eq. 12)", "length_m": "length (m)", "n_waypoints": "waypoints",
@@ -196,13 +197,13 @@ def sweep_lines(table, x: str | None = None, hue: str | None = None, y: str | No
     palette = matplotlib.colormaps["tab10" if len(hues) <= 10 else "tab20"].colors
     colours = {h: palette[i % len(palette)] for i, h in enumerate(hues)}
     fig, axes = _axes(ax, len(groups))
-    for a, (key, rows) in zip(axes, groups):
+    for a, (key, rows) in zip(axes, groups, strict=False):
         _lines(a, rows, x, hue, values, xs, hues, colours)
         a.set_xlabel(_label(x))
         a.set_ylabel(_label(y))
         key = key if isinstance(key, tuple) else (key,)
         note = objective_note(rows) if y in ("avg_delay_s", "total_delay_s", "fulfilment", "objective") else ""
-        a.set_title(", ".join(f"{k} = {_short(v)}" for k, v in zip(facets, key)) + (" — " if facets else "")
+        a.set_title(", ".join(f"{k} = {_short(v)}" for k, v in zip(facets, key, strict=True)) + (" — " if facets else "")
                     + "median over seeds, band: min–max" + (f"\n{note}" if note else ""), fontsize=9)
         if hue is not None:
             a.legend(title=_label(hue), fontsize=8, title_fontsize=8)
@@ -229,7 +230,7 @@ def _by_solver(table, key: str, y, ax, ylabel: str, xlabel: str) -> None:
 
     ok = table[table["status"] != "error"]
     solvers = _x_values(ok, "solver")
-    colours = dict(zip(solvers, matplotlib.colormaps["tab10"].colors))
+    colours = dict(zip(solvers, matplotlib.colormaps["tab10"].colors, strict=False))
     _lines(ax, ok, key, "solver", y(ok), _x_values(table, key), solvers, colours)
     ax.set_xlabel(xlabel)
     ax.set_ylabel(ylabel)
@@ -286,7 +287,7 @@ def _cell(table, key: str, ax):
     metrics = (("risk_cost", "operational risk (Eq. 11)"), ("transport_cost", "transport cost (¥, Eq. 12)"),
                ("n_waypoints", "number of waypoints"), ("seconds", "computing time (s)"))
     pos = np.arange(len(labels))
-    for i, (a, (column, title)) in enumerate(zip(axes, metrics)):
+    for i, (a, (column, title)) in enumerate(zip(axes, metrics, strict=False)):
         a.bar(pos - 0.2, rows[column].astype(float), width=0.4, label="uamopt")
         paper = [PAPER_TABLE4.get(label, (np.nan,) * 4)[i] for label in labels]
         if np.isfinite(paper).any():

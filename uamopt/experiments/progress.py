@@ -31,7 +31,8 @@ class Progress:
 
     def _line(self, note: str) -> None:
         elapsed = time.monotonic() - self.start
-        self.stream.write(f"{self.label}: {self.done}/{self.total} {self.unit}, {elapsed:.0f} s" + (f" - {note}" if note else "") + "\n")
+        self.stream.write(f"{self.label}: {self.done}/{self.total} {self.unit}, {elapsed:.0f} s"
+                          + (f" - {note}" if note else "") + "\n")
         self.stream.flush()
         self.last = time.monotonic()
 

@@ -150,7 +150,8 @@ def _table(raw: dict, key: str, where: str, label: str | None = None) -> dict:
     value = raw.get(key, {})
     if not isinstance(value, dict):
         raise ScenarioError(f"[{label}] must be a table, got {value!r}"[:200], where,
-                            f'write it as a table, e.g. [{label}] then "schedule.aircraft" = ' + ("[10, 20]" if "grid" in label else "10"))
+                            f'write it as a table, e.g. [{label}] then "schedule.aircraft" = '
+                            + ("[10, 20]" if "grid" in label else "10"))
     flat = _flatten(value)
     for name, item in flat.items():
         bad = _date_or_time(item)
@@ -176,7 +177,8 @@ def _date_or_time(value: Any):
 
 def _read(path: Path) -> dict:
     if not path.is_file():
-        raise UamoptError(f"sweep file not found: {path}", str(path), "give the path of a sweep .toml, e.g. models/variants/speed.toml")
+        raise UamoptError(f"sweep file not found: {path}", str(path),
+                          "give the path of a sweep .toml, e.g. models/variants/speed.toml")
     try:
         return tomllib.loads(path.read_text(encoding="utf-8"))
     except tomllib.TOMLDecodeError as exc:
@@ -316,8 +318,9 @@ def load_sweep(path: str | Path, small: bool = False) -> SweepSpec:
         stage, seeds or solvers, a case whose scenario is invalid.
     """
     expect_path(path, "path", "load_sweep")
+    from uamopt.shipped import scenario_path
 
-    path = Path(path)
+    path = Path(scenario_path(path))  # a shipped sweep's name (variants/speed), or models/... anywhere
     where = str(path)
     raw = _read(path)
     unknown = sorted(set(raw) - FILE_KEYS)
@@ -345,7 +348,8 @@ def load_sweep(path: str | Path, small: bool = False) -> SweepSpec:
     else:
         for key in ("solvers", "seeds", "time_limit_s"):
             if key in raw:
-                raise ScenarioError(f"'{key}' applies to stage = \"schedule\" only", where, "remove it or set stage = \"schedule\"")
+                raise ScenarioError(f"'{key}' applies to stage = \"schedule\" only", where,
+                                    "remove it or set stage = \"schedule\"")
         solvers, seeds = (), ()
     fixed = _table(raw, "set", where)
     grid = _table(raw, "grid", where)
@@ -356,7 +360,8 @@ def load_sweep(path: str | Path, small: bool = False) -> SweepSpec:
             raise ScenarioError(f"[grid] \"{key}\" must be a list of values, got {values!r}"[:200], where,
                                 f"write \"{key}\" = [{toml_value(values)}] (a list, even of one value)")
         if not values:
-            raise ScenarioError(f"empty grid: [grid] \"{key}\" has no values", where, f"give \"{key}\" a non-empty list of values")
+            raise ScenarioError(f"empty grid: [grid] \"{key}\" has no values", where,
+                                f"give \"{key}\" a non-empty list of values")
         if len({toml_value(v) for v in values}) != len(values):
             raise ScenarioError(f"[grid] \"{key}\" repeats a value", where, "list each value once")
         if key in fixed:
@@ -374,12 +379,13 @@ def load_sweep(path: str | Path, small: bool = False) -> SweepSpec:
     for key, value in fixed.items():  # name the faulty key before trying combinations
         _scenario(base, [f"{key}={toml_value(value)}"], f"{where} [set] \"{key}\"")
     for key, values in grid.items():
-        _scenario(base, fixed_overrides + [f"{key}={toml_value(values[0])}"], where, key)
+        _scenario(base, [*fixed_overrides, f"{key}={toml_value(values[0])}"], where, key)
     cases = []
     for index, combo in enumerate(itertools.product(*grid.values())):
-        values = dict(zip(grid, combo))
+        values = dict(zip(grid, combo, strict=True))  # combo is one value per key (product)
         overrides = tuple(fixed_overrides + [f"{k}={toml_value(v)}" for k, v in values.items()])
         shown = ", ".join(f"{k} = {toml_value(v)}" for k, v in values.items())
-        cases.append(Case(index, case_id(overrides), values, overrides, _scenario(base, list(overrides), f"{where} case {shown}")))
+        cases.append(Case(index, case_id(overrides), values, overrides,
+                          _scenario(base, list(overrides), f"{where} case {shown}")))
     return SweepSpec(path=path, name=name, base=base, stage=stage, solvers=solvers, seeds=seeds,
                      fixed=fixed, grid=grid, cases=tuple(cases), time_limit_s=time_limit, figure=figure, small=small)

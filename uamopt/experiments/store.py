@@ -38,7 +38,7 @@ import tempfile
 import warnings
 from pathlib import Path
 
-from uamopt.errors import UamoptError
+from uamopt.errors import NoSpaceError, UamoptError
 
 MANIFEST = "sweep.json"
 PARTS = "parts"
@@ -46,8 +46,8 @@ RESULTS = "results.parquet"
 
 #: column -> pandas dtype, in table order (the swept keys follow ``case``)
 HEAD = {"case": "str"}
-SCHEDULE = {"solver": "str", "seed": "Int64", "status": "str", "model": "str", "objective_kind": "str", "objective": "float64", "bound": "float64",
-            "gap": "float64", "operated": "Int64", "cancelled": "Int64", "total_delay_s": "float64",
+SCHEDULE = {"solver": "str", "seed": "Int64", "status": "str", "model": "str", "objective_kind": "str", "objective": "float64",
+            "bound": "float64", "gap": "float64", "operated": "Int64", "cancelled": "Int64", "total_delay_s": "float64",
             "avg_delay_s": "float64", "verified": "boolean", "seconds": "float64"}
 PLAN = {"risk_cost": "float64", "transport_cost": "float64", "length_m": "float64", "n_waypoints": "Int64"}
 RISK = {"unsafe_share": "float64", "band_unsafe_share": "float64", "cruise_unsafe_share": "float64",
@@ -114,7 +114,7 @@ def size_text(n: float) -> str:
 
 
 def out_of_space(exc: OSError, path: Path, size: int, need: int | None = None, where: str = "", keep: str = "",
-                 exact: bool = True) -> UamoptError:
+                 exact: bool = True) -> NoSpaceError:
     """The one-line error of a write to ``path`` (``size`` bytes; ``exact`` False: the bytes
     written when it stopped) that a full disk, a quota or a file-size limit stopped; ``need``: the
     bytes still to write, this file included; ``keep``: what the user keeps (the end of the fix)."""
@@ -126,7 +126,7 @@ def out_of_space(exc: OSError, path: Path, size: int, need: int | None = None, w
         soft = resource.getrlimit(resource.RLIMIT_FSIZE)[0]
         limit = (f"more than the file size limit of {size_text(soft)} (ulimit -f)" if soft != resource.RLIM_INFINITY
                  else "more than the file system's largest file")
-        return UamoptError(f"cannot write {path}: File too large: it needs {'' if exact else 'more than '}{size_text(size)}, "
+        return NoSpaceError(f"cannot write {path}: File too large: it needs {'' if exact else 'more than '}{size_text(size)}, "
                            f"{limit}", where,
                            f"raise the limit (ulimit -f) or write to another disk, {keep}")
     try:
@@ -135,7 +135,7 @@ def out_of_space(exc: OSError, path: Path, size: int, need: int | None = None, w
         free = "free space unknown"
     need = max(need or 0, size)
     amount = f"about {size_text(need)}" if exact or need > size else f"more than {size_text(size)}"
-    return UamoptError(f"cannot write {path}: {exc.strerror or 'No space left on device'}: needs {amount} to finish, {free}",
+    return NoSpaceError(f"cannot write {path}: {exc.strerror or 'No space left on device'}: needs {amount} to finish, {free}",
                        where,
                        f"free some space or write to another disk, {keep}")
 
@@ -257,7 +257,7 @@ def part_problem(frame, stage: str, name: str) -> str | None:
     for column in SHARES:
         if column in frame.columns and not frame[column].dropna().between(0.0, 1.0).all():
             return f"{column} is not a share from 0 to 1"
-    keys = [row_key(c, s, d) for c, s, d in zip(frame["case"], solver, seed)]
+    keys = [row_key(c, s, d) for c, s, d in zip(frame["case"], solver, seed, strict=True)]
     if len(set(keys)) != len(keys):
         return "it holds two rows for the same case, solver and seed"
     return None
@@ -288,7 +288,8 @@ def _manifest_problem(doc) -> str | None:
 def row_key(case, solver, seed) -> tuple:
     import pandas as pd
 
-    return (str(case), None if solver is None or pd.isna(solver) else str(solver), None if seed is None or pd.isna(seed) else int(seed))
+    return (str(case), None if solver is None or pd.isna(solver) else str(solver),
+            None if seed is None or pd.isna(seed) else int(seed))
 
 
 class ResultsFolder:
@@ -398,7 +399,7 @@ class ResultsFolder:
         if not frames:
             return None, broken
         rows = pd.concat(frames, ignore_index=True)
-        keys = [row_key(c, s, d) for c, s, d in zip(rows["case"], rows["solver"], rows["seed"])]
+        keys = [row_key(c, s, d) for c, s, d in zip(rows["case"], rows["solver"], rows["seed"], strict=True)]
         return rows[~pd.Series(keys).duplicated().to_numpy()].reset_index(drop=True), broken  # identical copies once
 
     def set_aside(self, broken: list, cases=None) -> list[str]:
@@ -456,7 +457,7 @@ class ResultsFolder:
     def write_part(self, case_id: str, frame, remaining: int = 0) -> Path:
         """Save one finished case's rows as a new part (a name no other part has); ``remaining``:
         the cases still to save after it (for the space a full disk's error says is needed)."""
-        keys = ",".join(f"{s}:{d}" for s, d in zip(frame["solver"].astype(object), frame["seed"].astype(object)))
+        keys = ",".join(f"{s}:{d}" for s, d in zip(frame["solver"].astype(object), frame["seed"].astype(object), strict=True))
         path = self.parts / f"{case_id}-{hashlib.sha1(keys.encode()).hexdigest()[:8]}.parquet"
         data = frame.to_parquet(None, index=False)
         parts = len(data) * (1 + remaining)

@@ -34,8 +34,14 @@ def _pair(text: str | None, option: str, example: str) -> tuple[float, float] | 
 
 
 def _simulation_options(p) -> None:
-    from uamopt.export.defaults import (DEFAULT_BANK_DEG, DEFAULT_BUDGET_H_M, DEFAULT_BUDGET_V_M, DEFAULT_DT_S,
-                                        DEFAULT_TRAJECTORY, TRAJECTORIES)
+    from uamopt.export.defaults import (
+        DEFAULT_BANK_DEG,
+        DEFAULT_BUDGET_H_M,
+        DEFAULT_BUDGET_V_M,
+        DEFAULT_DT_S,
+        DEFAULT_TRAJECTORY,
+        TRAJECTORIES,
+    )
 
     p.add_argument("dir", help="a schedule folder written by uamopt schedule")
     p.add_argument("--dt", type=float, default=DEFAULT_DT_S, help=f"BlueSky clock step, s (default {DEFAULT_DT_S:g})")

@@ -21,8 +21,8 @@ written before this key existed falls back to the synthetic anchor, and the expo
 from __future__ import annotations
 
 import functools
+import os
 from dataclasses import dataclass
-from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -137,6 +137,7 @@ def scenario_frame(scenario: Scenario) -> LocalFrame:
 def schedule_provenance(scenario: Scenario, overrides: list[str] | None = None) -> dict:
     """The ``frame`` and ``scenario`` keys ``uamopt schedule`` adds to summary.json."""
     source = scenario.source
-    file = str(Path(source).resolve()) if source and not source.startswith("<") else None
+    # absolute as the user named it: models/paper_case.toml stays so, not the package file its link leads to
+    file = os.path.abspath(source) if source and not source.startswith("<") else None
     return {"frame": scenario_frame(scenario).as_dict(),
             "scenario": {"name": scenario.name, "file": file, "set": list(overrides or [])}}

@@ -136,7 +136,8 @@ def unsafe_features(folder: ScheduleFolder, unsafe: np.ndarray, obstacle: np.nda
         geom = polys[0] if len(polys) == 1 else shapely.MultiPolygon(polys)
         out.append({"type": "Feature", "geometry": shapely.geometry.mapping(geom),
                     "properties": {"layer": k, "z_bottom_m": float(z[k] - cell[2] / 2), "z_top_m": float(z[k] + cell[2] / 2),
-                                   "z_centre_m": float(z[k]), "in_band": None if band is None else bool(band[0] - 1e-9 <= z[k] <= band[1] + 1e-9),
+                                   "z_centre_m": float(z[k]),
+                                   "in_band": None if band is None else bool(band[0] - 1e-9 <= z[k] <= band[1] + 1e-9),
                                    "unsafe_cells": int(unsafe[:, :, k].sum()), "obstacle_cells": int(obstacle[:, :, k].sum())}})
     return out
 

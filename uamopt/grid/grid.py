@@ -46,9 +46,9 @@ class AirspaceGrid:
             )
 
     @classmethod
-    def from_extent(cls, cell: tuple[float, float, float], extent: tuple[float, float, float]) -> "AirspaceGrid":
+    def from_extent(cls, cell: tuple[float, float, float], extent: tuple[float, float, float]) -> AirspaceGrid:
         """The largest grid of whole cells inside [0, x_max] × [0, y_max] × [0, z_max]."""
-        shape = tuple(int(np.floor(e / c + 1e-9)) for e, c in zip(extent, cell))
+        shape = tuple(int(np.floor(e / c + 1e-9)) for e, c in zip(extent, cell, strict=False))
         return cls(cell=tuple(float(c) for c in cell), shape=shape)  # type: ignore[arg-type]
 
     # --- geometry -------------------------------------------------------------------------
@@ -59,7 +59,7 @@ class AirspaceGrid:
     @property
     def extent(self) -> tuple[float, float, float]:
         """(x_max, y_max, z_max) actually covered by whole cells, m."""
-        return tuple(n * c for n, c in zip(self.shape, self.cell))  # type: ignore[return-value]
+        return tuple(n * c for n, c in zip(self.shape, self.cell, strict=False))  # type: ignore[return-value]
 
     def centres(self, axis: int) -> np.ndarray:
         """Cell-centre coordinates along one axis (0 = x, 1 = y, 2 = z), m."""
@@ -83,7 +83,7 @@ class AirspaceGrid:
 
     def centre_of(self, index: tuple[int, int, int]) -> tuple[float, float, float]:
         """Centre of cell (i, j, k), m."""
-        return tuple(float((i + 0.5) * c) for i, c in zip(index, self.cell))  # type: ignore[return-value]
+        return tuple(float((i + 0.5) * c) for i, c in zip(index, self.cell, strict=False))  # type: ignore[return-value]
 
     def indices_of(self, points: np.ndarray) -> np.ndarray:
         """Cell indices (…, 3) of points (…, 3) in metres; points on a face go to the upper cell.
@@ -128,7 +128,7 @@ class AirspaceGrid:
         return np.flatnonzero((z >= low_m - 1e-9) & (z <= high_m + 1e-9))
 
 
-def altitude_band(scenario: "Scenario") -> tuple[float, float]:
+def altitude_band(scenario: Scenario) -> tuple[float, float]:
     """max(h_min, h'_min) ≤ h ≤ min(h_max, h'_max) (Eq. 14), m. Default [90, 300]."""
     low = max(scenario.aircraft.h_min, scenario.grid.h_min_airspace)
     high = min(scenario.aircraft.h_max, scenario.grid.h_max_airspace)
@@ -185,7 +185,7 @@ def check_memory(cell, extent, limit_bytes: int) -> None:
     """Refuse a grid whose run would need more than ``limit_bytes``, before anything is allocated.
     The count is a float, so a tiny cell in a large extent (1e300 cells) is refused, not an overflow."""
     cells = 1.0
-    for e, c in zip(extent, cell):
+    for e, c in zip(extent, cell, strict=False):
         cells *= max(math.floor(e / c + 1e-9), 0) if math.isfinite(e / c) else math.inf
     need = cells * BYTES_PER_CELL
     if need > limit_bytes:

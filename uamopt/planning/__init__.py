@@ -5,5 +5,5 @@ from uamopt.planning.problem import PlanningModel, planning_model
 from uamopt.planning.search import SearchProblem, SearchResult, grid_search
 from uamopt.planning.tracks import STAGES, TrackPlan, TrackStage, TrackWeightsWarning, plan_track
 
-__all__ = ["PlanningModel", "STAGES", "SearchProblem", "SearchResult", "TrackPlan", "TrackStage",
+__all__ = ["STAGES", "PlanningModel", "SearchProblem", "SearchResult", "TrackPlan", "TrackStage",
            "TrackWeightsWarning", "grid_search", "plan_track", "planning_model"]

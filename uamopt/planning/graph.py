@@ -30,8 +30,8 @@ def passable_cells(field: RiskField) -> np.ndarray:
 def _shifted(mask: np.ndarray, offset: tuple[int, int, int]) -> np.ndarray:
     """``out[c] = mask[c + offset]``, False where c + offset leaves the grid."""
     out = np.zeros_like(mask)
-    src = tuple(slice(max(o, 0), n + min(o, 0)) for o, n in zip(offset, mask.shape))
-    dst = tuple(slice(max(-o, 0), n + min(-o, 0)) for o, n in zip(offset, mask.shape))
+    src = tuple(slice(max(o, 0), n + min(o, 0)) for o, n in zip(offset, mask.shape, strict=True))
+    dst = tuple(slice(max(-o, 0), n + min(-o, 0)) for o, n in zip(offset, mask.shape, strict=True))
     out[dst] = mask[src]
     return out
 
@@ -60,7 +60,7 @@ def grid_graph(passable: np.ndarray, cell: tuple[float, float, float], *, neighb
         src = np.argwhere(neighbour_moves(passable, offset))
         dst = src + np.asarray(offset)
         length = float(np.linalg.norm(np.asarray(offset) * np.asarray(cell, dtype=float)))
-        graph.add_edges_from(zip(map(tuple, src.tolist()), map(tuple, dst.tolist())), length=length)
+        graph.add_edges_from(zip(map(tuple, src.tolist()), map(tuple, dst.tolist()), strict=True), length=length)
     return graph
 
 
@@ -95,7 +95,7 @@ def to_networkx(field: RiskField, *, neighbourhood: int = 26) -> nx.Graph:
     centres = (idx + 0.5) * np.asarray(field.grid.cell)
     attrs = {
         (int(i), int(j), int(k)): {"pos": tuple(map(float, p)), "risk": float(r), "unsafe": bool(u)}
-        for (i, j, k), p, r, u in zip(idx, centres, field.risk[passable], field.unsafe[passable])
+        for (i, j, k), p, r, u in zip(idx, centres, field.risk[passable], field.unsafe[passable], strict=True)
     }
     nx.set_node_attributes(graph, attrs)
     return graph

@@ -244,7 +244,8 @@ def load_network(path: str | Path) -> RouteNetwork:
     except ValueError as exc:  # malformed JSON (an integer of more than 4300 digits too) or a field out of range
         from uamopt.bounds import parse_error
 
-        raise InputFileError(f"malformed network file: {parse_error(exc)}", str(path), "regenerate it with `uamopt network`") from None
+        raise InputFileError(f"malformed network file: {parse_error(exc)}", str(path),
+                             "regenerate it with `uamopt network`") from None
     except FileNotFoundError:
         raise InputFileError(f"network file not found: {path}", "network.json", "run `uamopt network` first") from None
     except (KeyError, TypeError, AttributeError, RecursionError) as exc:

@@ -54,7 +54,7 @@ def transport_rates(scenario: Scenario) -> tuple[float, float]:
 
 def buffer_cells(cell: tuple[float, float, float], clearance_m: float) -> tuple[int, int, int]:
     """n_s per axis: ⌈s_min / Δ⌉ · 2 + 1 (Sec. 5.1)."""
-    return tuple(int(math.ceil(clearance_m / d - 1e-9)) * 2 + 1 for d in cell)  # type: ignore[return-value]
+    return tuple(math.ceil(clearance_m / d - 1e-9) * 2 + 1 for d in cell)  # type: ignore[return-value]
 
 
 def box_counts(mask: np.ndarray, half: tuple[int, int, int], outside: bool = False) -> np.ndarray:
@@ -99,7 +99,7 @@ def clearance_ok(building: np.ndarray, cell: tuple[float, float, float], clearan
     # a layer s_min or more above the highest building cell is clear: the distance transform (the
     # planning model's largest cost at fine cells) runs on the layers below it only
     top = int(np.flatnonzero(building.any(axis=(0, 1)))[-1])
-    below = min(building.shape[2], top + int(math.ceil(clearance_m / cell[2] - 1e-9)))
+    below = min(building.shape[2], top + math.ceil(clearance_m / cell[2] - 1e-9))
     ok = np.ones(building.shape, dtype=bool)
     distance = ndimage.distance_transform_edt(~building[:, :, :below], sampling=cell)
     ok[:, :, :below] = distance >= clearance_m - 1e-9

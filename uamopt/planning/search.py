@@ -260,7 +260,7 @@ def _python(problem: SearchProblem, start: int, goal: int, bound: tuple[np.ndarr
             break
         for n, d in enumerate(OFFSETS):
             v = (u[0] + int(d[0]), u[1] + int(d[1]), u[2] + int(d[2]))
-            if not all(0 <= a < s for a, s in zip(v, shape)) or v in closed:
+            if not all(0 <= a < s for a, s in zip(v, shape, strict=False)) or v in closed:
                 continue
             if not all(passable[u[0] + c[0], u[1] + c[1], u[2] + c[2]] for c in CORNERS[n, : CORNER_COUNTS[n]]):
                 continue
@@ -307,7 +307,7 @@ def _networkx(problem: SearchProblem, start: int, goal: int, bound: tuple[np.nda
         path = nx.astar_path(graph, s, t, heuristic=heuristic, weight=weight)
     except (nx.NetworkXNoPath, nx.NodeNotFound):
         return None, math.inf, 0
-    cost = sum(weight(a, b, graph.edges[a, b]) for a, b in zip(path[:-1], path[1:]))
+    cost = sum(weight(a, b, graph.edges[a, b]) for a, b in itertools.pairwise(path))
     return np.asarray(path, dtype=np.int64), float(cost), 0
 
 
@@ -365,7 +365,7 @@ def grid_search(problem: SearchProblem, start: tuple[int, int, int], goal: tuple
     if heuristic not in HEURISTICS:
         raise ValueError(f"heuristic must be one of {list(HEURISTICS)}, got {heuristic!r}")
     for name, c in (("start", start), ("goal", goal)):
-        if len(c) != 3 or not all(0 <= int(v) < n for v, n in zip(c, problem.shape)):
+        if len(c) != 3 or not all(0 <= int(v) < n for v, n in zip(c, problem.shape, strict=True)):
             raise ValueError(f"{name} {tuple(c)} is not a cell of the grid of shape {problem.shape}")
         if not problem.passable[tuple(c)]:
             raise NoTrackError(f"the {name} cell {tuple(int(v) for v in c)} is not passable", "track search",

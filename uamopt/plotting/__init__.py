@@ -28,8 +28,8 @@ function                      draws                                             
 or inline in Jupyter; :mod:`uamopt.plotting.explore`), not a matplotlib Figure.
 
 Importing this package in Jupyter lets a returned Figure display as a PNG without pyplot
-(:func:`uamopt.plotting.style.show_figures_in`). This package imports matplotlib; ``import uamopt`` does not import it. The submodules ``risk``,
-``tracks``, ``network`` and ``schedule`` are shadowed here by the functions of the same name
+(:func:`uamopt.plotting.style.show_figures_in`). This package imports matplotlib; ``import uamopt`` does not import
+it. The submodules ``risk``, ``tracks``, ``network`` and ``schedule`` are shadowed here by the functions of the same name
 (import from them with ``from uamopt.plotting.tracks import STAGE_STYLE``); shared
 helpers are public in :mod:`uamopt.plotting.style` and :mod:`uamopt.plotting.geometry`.
 """

@@ -35,6 +35,7 @@ from pathlib import Path
 import numpy as np
 
 from uamopt.errors import UamoptError
+from uamopt.optional import need
 
 #: at most this many frames: the step grows for long schedules (a day at 10 s would be 8,640)
 MAX_FRAMES = 720
@@ -335,7 +336,7 @@ def explore(path, schedule=None, *, field=None, risk: str | Path | None = None, 
             return explore(path, risk=risk, scenario=scenario, overrides=overrides, step_s=step_s, city=city)
     if schedule is not None:
         raise TypeError("explore(folder): a schedule is given only with its problem, explore(problem, schedule)")
-    import plotly.graph_objects as go
+    go = need("plotly.graph_objects", extra="view", what="the 3-D view (uamopt view, explore)")
 
     from uamopt.export.folder import read_schedule_folder
 
@@ -416,7 +417,7 @@ def explore(path, schedule=None, *, field=None, risk: str | Path | None = None, 
     by_delay["marker"].update(colorscale="Viridis", cmin=0.0, cmax=max_delay, showscale=True,
                               line={"color": "#ffffff", "width": 1},
                               colorbar={"title": {"text": "delay (s)"}, "x": 1.02, "len": 0.5})
-    data = _plain(traces) + [by_route, by_delay]
+    data = [*_plain(traces), by_route, by_delay]
     clock = [f"{int(t // 3600):02d}:{int(t % 3600 // 60):02d}:{int(t % 60):02d}" for t in times]
     frames = [{"name": clock[k], "data": aircraft_traces(k), "traces": [first, first + 1]} for k in range(len(times))]
     cancelled = [f.id for f in flights if f.id not in {o.flight.id for o in operated}]
@@ -445,7 +446,7 @@ def explore(path, schedule=None, *, field=None, risk: str | Path | None = None, 
         "margin": {"l": 0, "r": 230, "t": 70, "b": 130}, "height": 820, "width": 1280, "uirevision": "keep",
         "updatemenus": [
             {"type": "buttons", "direction": "left", "x": 0.0, "y": 0.0, "xanchor": "left", "yanchor": "top",
-             "buttons": play + [pause], "showactive": False, "pad": {"t": 75}},
+             "buttons": [*play, pause], "showactive": False, "pad": {"t": 75}},
             {"type": "dropdown", "x": 0.32, "y": 0.0, "xanchor": "left", "yanchor": "top", "pad": {"t": 75},
              "buttons": [{"label": "colour: route", "method": "restyle", "args": [{"visible": vis_route}]},
                          {"label": "colour: delay", "method": "restyle", "args": [{"visible": vis_delay}]}]}],

@@ -170,7 +170,7 @@ def network(model, routes, ax=None, *, vertiports: Iterable = (), title: str = "
     ax_map, ax_prof = axes[0], (axes[1] if len(axes) > 1 else None)
     _muted_layer(ax_map, field, k)
     map_axes(ax_map, field)
-    for (forward, reverse), colour in zip(pairs, palette):
+    for (forward, reverse), colour in zip(pairs, palette, strict=True):
         for name, style, lw in ((forward, "-", 2.6), (reverse, WAY_BACK, 1.5)):
             if name is None:
                 continue
@@ -188,7 +188,7 @@ def network(model, routes, ax=None, *, vertiports: Iterable = (), title: str = "
     span = max(g.extent[:2])
     avoid = [(x, y) for _, x, y in ports] + [(x + 0.06 * span, y + 0.02 * span) for _, x, y in ports]
     anchors = _label_positions([tracks_m[f] for f, _ in pairs], avoid, 0.09 * span)
-    for n, (text, colour, (x, y)) in enumerate(zip(names, palette, anchors)):
+    for n, (text, colour, (x, y)) in enumerate(zip(names, palette, anchors, strict=True)):
         ax_map.annotate(str(n + 1) if keyed else text, (x, y), ha="center", va="center", fontsize=6.5, fontweight="bold",
                         color=tuple(0.75 * np.asarray(colors.to_rgb(colour))), zorder=9,
                         bbox={"boxstyle": "round,pad=0.18", "fc": "white", "ec": colour, "lw": 0.8, "alpha": 0.9})
@@ -228,7 +228,7 @@ def _network_profiles(ax, field, pairs, tracks_m, palette, keyed: bool = False) 
     ax.set_axis_off()
     wgap, hgap = 0.04 if ncols > 1 else 0.0, 0.16 / height_in  # axes fractions: room for each row's name
     width, height = (1.0 - wgap * (ncols - 1)) / ncols, (1.0 - hgap * nrows) / nrows
-    for i, ((forward, reverse), colour) in enumerate(zip(pairs, palette)):
+    for i, ((forward, reverse), colour) in enumerate(zip(pairs, palette, strict=True)):
         r, c = i % nrows, i // nrows  # down the first column, then the next
         row = ax.inset_axes([c * (width + wgap), 1.0 - (r + 1) * (height + hgap), width, height])
         for name, style in ((forward, "-"), (reverse, WAY_BACK)):

@@ -222,7 +222,7 @@ def _panel_unsafe_share(ax, field) -> None:
         "R > R₀": (field.unsafe & ~field.obstacle & ~field.no_fly).sum(axis=(0, 1)) / n,
     }
     left = np.zeros_like(z)
-    for (label, share), colour in zip(parts.items(), (OBSTACLE_GREY, NO_FLY, "#fd8d3c")):
+    for (label, share), colour in zip(parts.items(), (OBSTACLE_GREY, NO_FLY, "#fd8d3c"), strict=True):
         ax.barh(z, share, height=0.9 * dz, left=left, color=colour, label=label)
         left = left + share
     ax.axhspan(*field.band, color=BAND_GREEN, alpha=0.08, lw=0)
@@ -347,7 +347,7 @@ def risk_components(field, ax=None, *, title: str = "") -> Figure:
 
     fig, axes, page = panels(ax, 4, layout, figsize=(12.0, 4.0), single=False)
     free = ~field.obstacle
-    for i, (axis, name) in enumerate(zip(axes, ("risk_P", "risk_V", "risk_U", "risk"))):
+    for i, (axis, name) in enumerate(zip(axes, ("risk_P", "risk_V", "risk_U", "risk"), strict=False)):
         label, colour = PROFILE_STYLE[name]
         values = getattr(field, name)
         with warnings.catch_warnings():

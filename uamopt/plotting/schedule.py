@@ -72,7 +72,7 @@ def gantt(problem, schedule, ax=None, *, title: str = "") -> Figure:
                f"total delay {schedule.total_delay_s:.0f} s")
     fig, ax, _ = single_axes(ax, (14.0, max(4.0, 0.32 * len(aircraft) + 1.5)))
     ax.barh(y[on], duration[on], left=(planned + delay)[on], height=0.6,
-            color=[colour[k] for k, o in zip(keys, on) if o], edgecolor="black", linewidth=0.3)
+            color=[colour[k] for k, o in zip(keys, on, strict=True) if o], edgecolor="black", linewidth=0.3)
     ax.barh(y[~on], duration[~on], left=planned[~on], height=0.6, fill=False, hatch="///", edgecolor="grey",
             linewidth=0.6)
     late = on & (delay > 0)

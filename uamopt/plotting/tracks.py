@@ -344,7 +344,7 @@ def pareto(points, ax=None, *, plan=None, title: str = "") -> Figure:
         raise ValueError("points must hold at least one ParetoPoint (in every series)")
     several = len(series) > 1
     fig, ax, _ = single_axes(ax, (8.0, 5.5))
-    stages = [(name, marker, plan.stages[name]) for name, marker in zip(STAGES, "sDPo")] if plan is not None else []
+    stages = [(name, marker, plan.stages[name]) for name, marker in zip(STAGES, "sDPo", strict=True)] if plan is not None else []
     every = [p for pts in series.values() for p in pts]
     costs = [p.transport_cost for p in every] + [st.transport_cost for _, _, st in stages]
     focus = focus_range(costs)

@@ -93,7 +93,7 @@ def read_airland(path: str | Path):
     p, e, t, l_ = data["aircraft"], data["earliest"], data["target"], data["latest"]
     flights = tuple(Flight(id=f"a{i + 1}", aircraft=f"a{i + 1}", route="runway", origin="approach", destination="runway",
                            speed_mps=_SPEED_MPS, planned_departure_s=float(e[i]), max_delay_s=float(l_[i] - e[i]),
-                           waypoints=_TRACK + [0.0, 2.0 * i, 0.0]) for i in range(p))
+                           waypoints=_TRACK + np.array([0.0, 2.0 * i, 0.0])) for i in range(p))
     service_end = float(np.max(l_)) + 2.0  # never binds: the window is the delay bound
     fs = FlightSet(cell=(1.0, 1.0, 1.0), conflict_radius=0, flights=flights, service_start_s=float(min(0.0, np.min(e))),
                    service_end_s=service_end, outbound_gap_s=0.0, return_gap_s=0.0,

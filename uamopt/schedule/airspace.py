@@ -91,13 +91,13 @@ def check_tracks(scenario: Scenario, extent, tracks: Mapping[str, np.ndarray], c
     surface = load_city(scenario, grid).surface_height
     shape = np.asarray(grid.shape[:2]) - 1
     for name, w in unique.values():
-        p = _points(w, grid.cell)
-        ij = np.clip(np.floor(p[:, :2] / np.asarray(grid.cell[:2])).astype(np.int64), 0, shape)
+        pts = _points(w, grid.cell)
+        ij = np.clip(np.floor(pts[:, :2] / np.asarray(grid.cell[:2])).astype(np.int64), 0, shape)
         top = surface[ij[:, 0], ij[:, 1]]
-        inside = p[:, 2] < top - TOL_M
+        inside = pts[:, 2] < top - TOL_M
         if inside.any():
             k = int(np.argmax(inside))
-            at = ", ".join(f"{v:.1f}" for v in p[k])
+            at = ", ".join(f"{v:.1f}" for v in pts[k])
             raise InputFileError(
                 f"the track passes through a building: ({at}) is below the city's surface at {top[k]:.1f} m "
                 f"(column {tuple(int(v) for v in ij[k])} of {', '.join(f'{c:g}' for c in grid.cell)} m cells)",

@@ -90,6 +90,13 @@ class Objective:
         return self.target_s is not None
 
     @property
+    def terms(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(a_f, e_f, l_f): the target delays and the costs per second early and late (earliness/tardiness only)."""
+        a, e, late = self.target_s, self.early_per_s, self.late_per_s
+        assert a is not None and e is not None and late is not None, "only earliness_tardiness has per-flight terms"
+        return a, e, late
+
+    @property
     def linear(self) -> bool:
         """W = per_delay · Σ c d − per_flight · Σ c exactly (no per-flight terms, no operating costs)."""
         return self.target_s is None and self.operate_cost_s is None
@@ -114,8 +121,9 @@ class Objective:
         if self.operate_cost_s is not None:
             out = out + self.per_delay * self.operate_cost_s[flights]
         if self.per_flight_terms:
-            a = self.target_s[flights]
-            out = out + self.early_per_s[flights] * np.maximum(0.0, a - d) + self.late_per_s[flights] * np.maximum(0.0, d - a)
+            target, early, late = self.terms
+            a = target[flights]
+            out = out + early[flights] * np.maximum(0.0, a - d) + late[flights] * np.maximum(0.0, d - a)
         return out
 
     def cost(self, operated: np.ndarray, delay_s: np.ndarray) -> float:
@@ -137,7 +145,7 @@ class Objective:
     @property
     def preferred_delay_s(self) -> np.ndarray | float:
         """The delay an operated flight would choose alone: its target (earliness/tardiness), else 0."""
-        return self.target_s if self.per_flight_terms else 0.0
+        return self.terms[0] if self.per_flight_terms else 0.0
 
     def scaled_delay(self, unit_s: float) -> Fraction:
         """The exact weight of one delay unit of ``unit_s`` seconds (weighted kind only)."""
@@ -173,7 +181,8 @@ class PairView:
         ptr_out, lo_out, hi_out = [0], [], []
         for k in range(len(self.p)):
             start, end = float(self.reach_lo[k]), float(self.reach_hi[k])
-            for lo, hi in zip(self.lo[self.ptr[k]:self.ptr[k + 1]].tolist(), self.hi[self.ptr[k]:self.ptr[k + 1]].tolist()):
+            rows = slice(self.ptr[k], self.ptr[k + 1])
+            for lo, hi in zip(self.lo[rows].tolist(), self.hi[rows].tolist(), strict=True):
                 if min(lo, end) >= start:
                     lo_out.append(start)
                     hi_out.append(min(lo, end))
@@ -187,7 +196,7 @@ class PairView:
     def gaps_of(self, k: int) -> list[tuple[float, float]]:
         """The admissible closed gaps [(g, h), ...] of pair k."""
         ptr, lo, hi = self.gaps
-        return list(zip(lo[ptr[k]:ptr[k + 1]].tolist(), hi[ptr[k]:ptr[k + 1]].tolist()))
+        return list(zip(lo[ptr[k]:ptr[k + 1]].tolist(), hi[ptr[k]:ptr[k + 1]].tolist(), strict=True))
 
 
 def pair_view(p: np.ndarray, q: np.ndarray, ptr: np.ndarray, intervals: np.ndarray, planned_departure_s: np.ndarray,

@@ -334,7 +334,8 @@ def flight_from_dict(raw: Any, where: str, network: Mapping[str, np.ndarray] | N
         wp = np.array(network[raw["route"]], dtype=float)
     else:
         known = ", ".join(sorted(network)) if network else "none (no network given)"
-        raise InputFileError(f"unknown route '{str(raw['route'])[:80]}'", where, f"give 'waypoints' or one of the routes: {known}")
+        raise InputFileError(f"unknown route '{str(raw['route'])[:80]}'", where,
+                             f"give 'waypoints' or one of the routes: {known}")
     if track_length_m(wp) <= 0:
         raise InputFileError("the track has zero length", where, "give an origin and a destination that differ")
     rate = raw.get("vertical_rate_mps")
@@ -410,9 +411,10 @@ def check_flightset(flightset: FlightSet, grid: AirspaceGrid | None = None, sour
 
 def _fill_max_delay(flightset: FlightSet) -> FlightSet:
     """Δd = round(L/v_g) + ΔT (Eq. 29 with equality) where the file gives none."""
+    gaps = flightset.turnaround_after_s.tolist()  # every flight's ΔT, filled in by FlightSet
     flights = tuple(
-        replace(f, max_delay_s=round_half_up(f.flight_time_s) + f.turnaround_after_s) if math.isnan(f.max_delay_s) else f
-        for f in flightset.flights
+        replace(f, max_delay_s=round_half_up(f.flight_time_s) + gap) if math.isnan(f.max_delay_s) else f
+        for f, gap in zip(flightset.flights, gaps, strict=True)
     )
     return replace(flightset, flights=flights)
 
@@ -449,7 +451,8 @@ def load_flights(
     try:
         raw = json.loads(path.read_text(encoding="utf-8-sig"))
     except json.JSONDecodeError as exc:
-        raise InputFileError(f"malformed JSON: {exc.msg} at line {exc.lineno} column {exc.colno}", source, "fix the syntax") from None
+        raise InputFileError(f"malformed JSON: {exc.msg} at line {exc.lineno} column {exc.colno}", source,
+                             "fix the syntax") from None
     except UnicodeDecodeError:
         raise InputFileError("flights file is not UTF-8 text", source, "save it as UTF-8 JSON") from None
     except ValueError as exc:  # an integer of more than 4300 digits (Python's int-string limit)
@@ -462,7 +465,8 @@ def load_flights(
         raise InputFileError(f"cannot read the flights file: {exc.strerror or exc}", source,
                              "check that the file is readable") from None
     if not isinstance(raw, dict) or not isinstance(raw.get("flights"), list):
-        raise InputFileError("missing key 'flights' (a list)", source, 'write {"cell": [...], "conflict_radius": r, "flights": [...]}')
+        raise InputFileError("missing key 'flights' (a list)", source,
+                             'write {"cell": [...], "conflict_radius": r, "flights": [...]}')
     if not raw["flights"]:
         raise InputFileError("the file holds no flights", source, "add at least one flight")
     sched = scenario.schedule if scenario is not None else None
@@ -485,7 +489,9 @@ def load_flights(
         # the file's cell overrides the scenario's, within the same memory limit (tiny cells are refused)
         grid = file_grid(grid.extent, cell_t, scenario.grid.memory_limit_gb if scenario else None, source)
     flights = tuple(flight_from_dict(f, source, network) for f in raw["flights"])
-    flightset = _fill_max_delay(FlightSet(cell=cell_t, conflict_radius=radius, flights=flights, **numbers))
+    flightset = _fill_max_delay(FlightSet(cell=cell_t, conflict_radius=radius, flights=flights,
+                                          service_start_s=numbers["service_start_s"], service_end_s=numbers["service_end_s"],
+                                          outbound_gap_s=numbers["outbound_gap_s"], return_gap_s=numbers["return_gap_s"]))
     check_flightset(flightset, grid, source)
     return flightset
 

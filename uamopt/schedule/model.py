@@ -64,7 +64,9 @@ class SchedulingProblem:
     aircraft_count: int = 0  # G, Eq. 21: the number of distinct aircraft in ``flights`` (0: fill it in)
     objective_kind: ObjectiveKind = "weighted"
     time_step_s: float = 10.0  # ΔT_a (Table B.3): the heuristics' delay grid unless a profile sets step_s
-    must_operate: np.ndarray | None = None  # (n,) bool: flights that may not be cancelled (core.py); None: none
+    #: (n,) bool: flights that may not be cancelled (core.py); None: none. Typed as what __post_init__ makes of it
+    #: (always an (n,) bool array), so that readers need not narrow it: the None default is the ignore's reason
+    must_operate: np.ndarray = None  # type: ignore[assignment]  # None default: __post_init__ makes the array
     #: families beyond the paper's five (uamopt.schedule.families), e.g. a departure spacing
     extra_families: tuple = ()
     #: the objective itself when it is not made from the weights and the delay bounds (kind
@@ -78,8 +80,8 @@ class SchedulingProblem:
         if self.objective_kind not in ("weighted", "lexicographic", "earliness_tardiness"):
             raise UamoptError(f"unknown objective '{self.objective_kind}'", "schedule objective", "use weighted or lexicographic")
         if self.objective_kind == "earliness_tardiness" and self.objective_terms is None:
-            raise UamoptError("objective earliness_tardiness needs its terms (objective_terms=Objective.earliness_tardiness(...))",
-                              "SchedulingProblem", "give objective_terms")
+            raise UamoptError("objective earliness_tardiness needs its terms "
+                              "(objective_terms=Objective.earliness_tardiness(...))", "SchedulingProblem", "give objective_terms")
         if self.objective_terms is not None and self.objective_terms.kind != self.objective_kind:
             raise UamoptError(f"objective_terms is of kind {self.objective_terms.kind}, not {self.objective_kind}",
                               "SchedulingProblem", "give terms of the problem's objective kind")
@@ -208,7 +210,7 @@ def build_problem(
     check_plan_memory(scenario, len(flightset) * copies, 0, candidate_count(flightset) * copies**2,
                       "schedule.aircraft / schedule.flights / --flights")
     if weights is None:
-        weights = tuple(scenario.schedule.weights) if scenario is not None else (0.6, 0.4)  # type: ignore[assignment]
+        weights = tuple(scenario.schedule.weights) if scenario is not None else (0.6, 0.4)
     if scenario is not None and scenario.schedule.speed_change_cost_s > 0 and tuple(scenario.schedule.speed_options) == (1.0,):
         from uamopt.errors import ScenarioError
 
@@ -223,7 +225,7 @@ def build_problem(
                              time_step_s=float(scenario.schedule.time_step_s),
                              families_of=lambda fs: scenario_families(fs, scenario))
     return SchedulingProblem(
-        flights=flightset, conflicts=conflict_table(flightset), weights=tuple(float(w) for w in weights),  # type: ignore[arg-type]
+        flights=flightset, conflicts=conflict_table(flightset), weights=tuple(float(w) for w in weights),  # type: ignore[arg-type]  # 2 in, 2 out
         aircraft_count=flightset.n_aircraft, objective_kind=objective,
         time_step_s=float(scenario.schedule.time_step_s) if scenario is not None else 10.0,
         extra_families=scenario_families(flightset, scenario),
@@ -362,7 +364,6 @@ def write_schedule(out_dir: str | Path, problem: SchedulingProblem, schedule: Sc
     """
     schedule.raise_for_status()
     from uamopt.outputs import staged_output, write_json
-
     from uamopt.schedule.families.speed import collapse, speed_choice_of
 
     choice = speed_choice_of(problem)
@@ -388,7 +389,8 @@ def write_schedule(out_dir: str | Path, problem: SchedulingProblem, schedule: Sc
         save_flights(stage / "flights.json", fs)
         with open(stage / "schedule.csv", "w", newline="", encoding="utf-8") as fh:
             writer = csv.writer(fh)
-            writer.writerow(["flight", "aircraft", "route", "operated", "planned_departure_s", "delay_s", "departure_s", "arrival_s"])
+            writer.writerow(["flight", "aircraft", "route", "operated", "planned_departure_s", "delay_s", "departure_s",
+                             "arrival_s"])
             for i, f in enumerate(fs.flights):
                 on = bool(schedule.operated[i])
                 writer.writerow([

@@ -43,6 +43,7 @@ the flight pairs whose departure windows can meet are matched to their track pai
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import overload
 
 import numpy as np
 
@@ -137,7 +138,7 @@ def flight_occupancies(flightset: FlightSet) -> tuple[list[Occupancy], np.ndarra
     Returns ``(occupancies, key)``: one :class:`Occupancy` per distinct (track, speed), and for
     each flight the index of its occupancy.
     """
-    index: dict[tuple[bytes, float], int] = {}
+    index: dict[tuple[bytes, float, float | None], int] = {}  # (waypoints, speed, vertical rate)
     occupancies: list[Occupancy] = []
     key = np.empty(len(flightset), dtype=np.int64)
     for i, f in enumerate(flightset.flights):
@@ -189,6 +190,10 @@ def _cell_codes(cells: np.ndarray, radius: int) -> tuple[np.ndarray, np.ndarray]
     return (c[:, 0] * dims[1] + c[:, 1]) * dims[2] + c[:, 2], offsets
 
 
+@overload
+def _near_pairs(code: np.ndarray, offsets: np.ndarray, max_pairs: None = None) -> tuple[np.ndarray, np.ndarray]: ...
+@overload
+def _near_pairs(code: np.ndarray, offsets: np.ndarray, max_pairs: int | None) -> tuple[np.ndarray, np.ndarray] | None: ...
 def _near_pairs(code: np.ndarray, offsets: np.ndarray, max_pairs: int | None = None) -> tuple[np.ndarray, np.ndarray] | None:
     """All (i, j) with code[j] + o == code[i] for an offset o: a sort-merge join of the rows with
     their dilated copies, one vectorised pass per offset. ``None`` if there would be more than
@@ -279,7 +284,7 @@ def flight_pair_gaps(
         hi_cut = min(hi_cut, n_buckets)
         part = slice(cuts[lo_cut], cuts[hi_cut])
         rows, bk = row[part], bucket[part]
-        base, probe = _near_pairs(code[visit[rows]] * n_buckets + bk, offsets * n_buckets)  # type: ignore[misc]
+        base, probe = _near_pairs(code[visit[rows]] * n_buckets + bk, offsets * n_buckets)
         rb, rp = rows[base], rows[probe]
         keep = flight[rb] < flight[rp]  # one orientation, no flight with itself: the most selective test first
         base, rb, rp = base[keep], rb[keep], rp[keep]
@@ -294,7 +299,7 @@ def flight_pair_gaps(
         lo_cut = hi_cut
     if not found:
         return np.zeros(0, dtype=np.int64), np.zeros(1, dtype=np.int64), np.zeros(0), np.zeros(0)
-    g, lo, hi = _group_merge(*(np.concatenate(parts) for parts in zip(*found)))
+    g, lo, hi = _group_merge(*(np.concatenate(parts) for parts in zip(*found, strict=True)))
     pair_code, starts = np.unique(g, return_index=True)
     return pair_code, np.append(starts, len(g)).astype(np.int64), lo, hi
 
@@ -386,13 +391,13 @@ def _prune_to_ranges(flightset, p, q, grp, pair_code, ptr, lo, hi) -> ConflictTa
     last = np.empty(len(grp), dtype=np.int64)
     group_of = np.repeat(np.arange(len(pair_code)), np.diff(ptr))
     for g0, g1 in _chunks(ptr, span):
-        rows = slice(ptr[g0], ptr[g1])
-        off = (group_of[rows] - g0) * span
+        span_rows = slice(ptr[g0], ptr[g1])
+        off = (group_of[span_rows] - g0) * span
         a, b = np.searchsorted(grp[order], [g0, g1])
         qs = order[a:b]
         q_off = (grp[qs] - g0) * span
-        first[qs] = ptr[g0] + np.searchsorted(off + hi_key[rows], q_off + q_lo[qs], side="right")
-        last[qs] = ptr[g0] + np.searchsorted(off + lo_key[rows], q_off + q_hi[qs], side="left")
+        first[qs] = ptr[g0] + np.searchsorted(off + hi_key[span_rows], q_off + q_lo[qs], side="right")
+        last[qs] = ptr[g0] + np.searchsorted(off + lo_key[span_rows], q_off + q_hi[qs], side="left")
     meet = last > first
     p, q, first, last = p[meet], q[meet], first[meet], last[meet]
     order = np.lexsort((q, p))

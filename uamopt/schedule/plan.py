@@ -201,8 +201,9 @@ def generate_plan(
         A route missing from ``network``, a bad scale, or flights that cannot fit in the service
         window even with no slack.
     """
-    if callable(getattr(network, "waypoints", None)):  # a RouteNetwork
-        network = network.waypoints()
+    waypoints = getattr(network, "waypoints", None)
+    if callable(waypoints):  # a RouteNetwork
+        network = waypoints()
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
         raise UamoptError(f"the plan seed must be a whole number ≥ 0, got {seed!r}", "--seed / schedule.plan_seed",
                           "give 0, 1, 2, ...")
@@ -232,7 +233,8 @@ def generate_plan(
     for a, b in routes:
         for name in (route_name(a, b), route_name(b, a)):
             if name not in network:
-                raise UamoptError(f"unknown route '{name}'", "network", f"give tracks for every route; known: {', '.join(network)}")
+                raise UamoptError(f"unknown route '{name}'", "network",
+                                  f"give tracks for every route; known: {', '.join(network)}")
     if total is None:
         longest = speed * max(waypoint_times_s(t, speed, rate)[-1] for t in network.values())  # L_g/v_g: the longest flight time
         each = flights_per_aircraft(service_s, longest, speed, sched.outbound_gap_s, sched.return_gap_s, sched.interference)
@@ -268,19 +270,19 @@ def generate_plan(
         steps = math.floor(width_g / step + 1e-9)
         departure = service_start_s + step * float(rng.integers(0, steps + 1))
         aircraft_id = f"A{g + 1:0{width}d}"
-        for (o, d), t, gap in zip(legs, times, gaps):
+        for (o, d), t, gap in zip(legs, times, gaps, strict=True):
             plan.append(Flight(
                 id=f"F{len(plan) + 1:03d}", aircraft=aircraft_id, route=route_name(o, d), origin=o, destination=d,
                 speed_mps=speed, planned_departure_s=departure, max_delay_s=round_half_up(scale * (round_half_up(t) + gap)),
                 waypoints=network[route_name(o, d)], turnaround_after_s=gap, vertical_rate_mps=rate,
             ))
             departure = departure + t + gap
-    notes = ()
+    notes: tuple[str, ...] = ()
     if narrowed:
         notes = (f"first_departure_window_s = {window:g} s does not fit {len(narrowed)} of {n_aircraft} aircraft; "
                  f"their first departures were drawn from the slack they have (down to {min(narrowed):.0f} s)",)
     flightset = FlightSet(
-        cell=tuple(cell) if cell is not None else tuple(scenario.grid.cell),  # type: ignore[arg-type]
+        cell=tuple(cell) if cell is not None else tuple(scenario.grid.cell),  # type: ignore[arg-type]  # tuple() of 3 is 3 long
         conflict_radius=sched.conflict_radius, flights=tuple(plan), service_start_s=service_start_s,
         service_end_s=service_end, outbound_gap_s=sched.outbound_gap_s, return_gap_s=sched.return_gap_s, notes=notes,
     )

@@ -55,6 +55,7 @@ import itertools
 import math
 from collections import defaultdict
 from pathlib import Path
+from typing import Any
 
 from uamopt.errors import InputFileError
 from uamopt.schedule.verify_summary import TOL_S, check_summary, read_json, shown
@@ -69,6 +70,7 @@ MAX_COORD_M = 1e6  # waypoint coordinates of the local frame, m (1,000 km)
 VERTICAL_RATE_MPS = 50.0  # largest vertical_rate_mps a flight file may claim (exclusive lower bound 0), m/s
 VERTICAL_XY_M = 1e-6  # a vertical segment's waypoints share x and y within this, m
 MAX_VISITS = 10_000_000  # cell visits and time buckets the conflict search may hold (about 1 GB)
+MAX_CONFLICTS = 10_000  # conflicting pairs listed; past it the search stops (the schedule is already infeasible)
 ULP = 1e-14  # float round-off per unit of magnitude allowed on top of TOL_S (1e-7 s at 10⁷ s)
 
 
@@ -104,7 +106,7 @@ def cell_visits(waypoints, speed_mps: float, cell,
         raise ValueError(f"segment_speeds has {len(speeds)} speeds for {n_segments} segments")
     raw: list[tuple[tuple[int, int, int], float, float]] = []
     t = 0.0
-    for (p0, p1), speed in zip(itertools.pairwise(waypoints), speeds):
+    for (p0, p1), speed in zip(itertools.pairwise(waypoints), speeds, strict=True):
         d = [p1[a] - p0[a] for a in range(3)]
         length = math.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
         if length == 0.0:
@@ -172,7 +174,8 @@ def _read_flights(path: Path) -> dict:
         flights = raw["flights"]
         cell = [_number(c, "cell", str(path)) for c in raw["cell"]]
     except (KeyError, TypeError, ValueError):
-        raise InputFileError("missing or malformed 'flights' or 'cell'", str(path), "rewrite the file with uamopt schedule") from None
+        raise InputFileError("missing or malformed 'flights' or 'cell'", str(path),
+                             "rewrite the file with uamopt schedule") from None
     if len(cell) != 3 or min(cell) <= 0 or not isinstance(flights, list):
         raise InputFileError(f"cell must be three positive sizes in metres and flights a list, got cell {shown(raw['cell'])}",
                              str(path), "rewrite the file with uamopt schedule")
@@ -180,7 +183,7 @@ def _read_flights(path: Path) -> dict:
     if isinstance(radius, bool) or not isinstance(radius, int) or not 0 <= radius <= MAX_RADIUS:
         raise InputFileError(f"conflict_radius must be an integer in [0, {MAX_RADIUS}], got {shown(radius)}", str(path),
                              "rewrite the file with uamopt schedule (the scenario's schedule.conflict_radius)")
-    out = {
+    out: dict[str, Any] = {
         "cell": cell, "radius": radius, "flights": [],
         "service_start_s": _number(raw.get("service_start_s", 0.0), "service_start_s", str(path)),
         "service_end_s": _number(raw.get("service_end_s", 3600.0), "service_end_s", str(path)),
@@ -196,10 +199,11 @@ def _read_flights(path: Path) -> dict:
     for f in flights:
         where = f"{path}: flight {str(f.get('id'))[:40] if isinstance(f, dict) else '?'}"
         if not isinstance(f, dict) or "waypoints" not in f:
-            raise InputFileError("flight without waypoints", where, "the verifier needs self-contained flights (uamopt schedule writes them)")
+            raise InputFileError("flight without waypoints", where,
+                                 "the verifier needs self-contained flights (uamopt schedule writes them)")
         try:
             wps = [tuple(_coordinate(v) for v in p) for p in f["waypoints"]]
-            rec = {
+            rec: dict[str, Any] = {
                 "id": str(f["id"]), "aircraft": str(f["aircraft"]), "route": str(f["route"]),
                 "speed": _number(f["speed_mps"], "speed_mps", where),
                 "planned": _number(f["planned_departure_s"], "planned_departure_s", where),
@@ -244,8 +248,8 @@ def _phases(rec: dict, rate, where: str) -> None:
         return
     # the range first: it is exact on an integer of any size (math.isfinite would overflow) and refuses NaN and inf
     if isinstance(rate, bool) or not isinstance(rate, (int, float)) or not 0 < rate <= VERTICAL_RATE_MPS:
-        raise InputFileError(f"flight {rec['id']}: vertical_rate_mps must be a number in (0, {VERTICAL_RATE_MPS:g}] m/s, got {shown(rate)}", where,
-                             "rewrite the file with uamopt schedule")
+        raise InputFileError(f"flight {rec['id']}: vertical_rate_mps must be a number in (0, {VERTICAL_RATE_MPS:g}] m/s, "
+                             f"got {shown(rate)}", where, "rewrite the file with uamopt schedule")
     rate = float(rate)
 
     def vertical(a, b) -> bool:
@@ -253,7 +257,8 @@ def _phases(rec: dict, rate, where: str) -> None:
 
     if len(wps) < 4 or not (vertical(wps[0], wps[1]) and wps[1][2] > wps[0][2]
                             and vertical(wps[-2], wps[-1]) and wps[-2][2] > wps[-1][2]):
-        raise InputFileError(f"flight {rec['id']}: vertical_rate_mps needs a vertical first and last segment: at least 4 waypoints, "
+        raise InputFileError(f"flight {rec['id']}: vertical_rate_mps needs a vertical first and last segment: "
+                             "at least 4 waypoints, "
                              "ground -> top of climb (same x, y, higher z) ... top of descent -> ground (same x, y, "
                              f"lower z), got {len(wps)} waypoints", where, "rewrite the file with uamopt schedule")
     cruise_length = sum(math.dist(a, b) for a, b in itertools.pairwise(wps[1:-1]))
@@ -298,7 +303,8 @@ def _parse_schedule(path: Path, rows: dict[str, dict]) -> dict[str, dict]:
     with open(path, newline="", encoding="utf-8-sig") as fh:  # -sig: a spreadsheet's BOM is not a column name
         reader = csv.DictReader(fh)
         if reader.fieldnames is None or any(c not in reader.fieldnames for c in COLUMNS):
-            raise InputFileError(f"schedule.csv needs the columns {','.join(COLUMNS)}", str(path), "rewrite it with uamopt schedule")
+            raise InputFileError(f"schedule.csv needs the columns {','.join(COLUMNS)}", str(path),
+                                 "rewrite it with uamopt schedule")
         for n, row in enumerate(reader, start=2):
             where = f"{path}: line {n}"
             if any(row.get(c) is None for c in COLUMNS[:5]):  # a short row: DictReader fills the missing fields with None
@@ -306,7 +312,8 @@ def _parse_schedule(path: Path, rows: dict[str, dict]) -> dict[str, dict]:
                                      "rewrite it with uamopt schedule")
             flag = row["operated"].strip().lower()
             if flag not in ("1", "0", "true", "false"):
-                raise InputFileError(f"operated must be 1 or 0, got {shown(row['operated'])}", where, "rewrite it with uamopt schedule")
+                raise InputFileError(f"operated must be 1 or 0, got {shown(row['operated'])}", where,
+                                     "rewrite it with uamopt schedule")
             on = flag in ("1", "true")
             rec = {"row": row, "line": n, "operated": on, "duplicate": row["flight"] in rows,
                    "planned": _number(row["planned_departure_s"], "planned_departure_s", where),
@@ -326,7 +333,9 @@ def _conflicts(flights: list[dict], cell, radius: int) -> list[str]:
     A block is ``BLOCK`` cells per axis (≥ r), so cells within r of each other lie in the same or
     adjacent blocks; each unordered pair of neighbouring keys is visited once (half the offsets),
     and every candidate pair of visits is tested exactly: Chebyshev distance of the cells ≤ r
-    and an overlap in time longer than ``TOL_S``.
+    and an overlap in time longer than ``TOL_S``. The search stops at ``MAX_CONFLICTS`` pairs, and
+    says so: 8,000 flights through one cell at once are 32 million pairs, each a conflict, which
+    took the search past 3 GB and minutes to list; one is enough for the verdict.
     """
     block = max(1, radius, BLOCK)
     cache: dict = {}
@@ -339,7 +348,7 @@ def _conflicts(flights: list[dict], cell, radius: int) -> list[str]:
             a, b = f["departure"] + a, f["departure"] + b
             home = (c[0] // block, c[1] // block, c[2] // block)
             for bucket in range(math.floor(a / BUCKET_S), math.floor(b / BUCKET_S) + 1):
-                table[home + (bucket,)].append((n, a, b, c))
+                table[(*home, bucket)].append((n, a, b, c))
     reach = 1 if radius > 0 else 0
     offsets = [o for o in itertools.product(range(-reach, reach + 1), repeat=3) if o > (0, 0, 0)]
     worst: dict[tuple[int, int], tuple] = {}
@@ -356,20 +365,33 @@ def _conflicts(flights: list[dict], cell, radius: int) -> list[str]:
                     continue
                 pair, info = ((n1, n2), (overlap, c1, c2)) if n1 < n2 else ((n2, n1), (overlap, c2, c1))
                 if overlap > worst.get(pair, (0.0,))[0]:
-                    worst[pair] = info + (max(a1, a2), min(b1, b2))
+                    worst[pair] = (*info, max(a1, a2), min(b1, b2))
+                    if len(worst) >= MAX_CONFLICTS:
+                        raise _Enough
 
-    for (i, j, k, bucket), entries in table.items():
-        compare(entries, entries, True)
-        for o in offsets:
-            others = table.get((i + o[0], j + o[1], k + o[2], bucket))
-            if others:
-                compare(entries, others, False)
+    stopped = False
+    try:
+        for (i, j, k, bucket), entries in table.items():
+            compare(entries, entries, True)
+            for o in offsets:
+                others = table.get((i + o[0], j + o[1], k + o[2], bucket))
+                if others:
+                    compare(entries, others, False)
+    except _Enough:
+        stopped = True
     out = []
     for (n1, n2), (_, c1, c2, a, b) in sorted(worst.items()):
         f1, f2 = flights[n1], flights[n2]
         out.append(f"conflict: flights {f1['id']} ({f1['aircraft']}) in cell {c1} and {f2['id']} ({f2['aircraft']}) "
                    f"in cell {c2} overlap from {a:.3f} s to {b:.3f} s")
+    if stopped:
+        out.append(f"conflict: the search stopped at {MAX_CONFLICTS:,} conflicting pairs (more may exist; the first "
+                   "found are listed, each with its overlap when found)")
     return out
+
+
+class _Enough(Exception):
+    """MAX_CONFLICTS conflicting pairs found: the conflict search stops."""
 
 
 def verify_files(flights_path: Path, schedule_path: Path, summary_path: Path | None = None) -> list[str]:
@@ -416,7 +438,8 @@ def verify_files(flights_path: Path, schedule_path: Path, summary_path: Path | N
             out.append(f"flight {f['id']}: arrival {f['arrival']} s ≠ departure + climb {f['climb_s']:.6f} s + cruise "
                        f"{f['cruise_s']:.6f} s + descent {f['descent_s']:.6f} s = {f['departure'] + f['duration']:.6f} s")
         if f["arrival"] > spec["service_end_s"] + TOL_S:
-            out.append(f"flight {f['id']}: arrives at {f['arrival']:.3f} s, after the service end {spec['service_end_s']:g} s (Eq. 26)")
+            out.append(f"flight {f['id']}: arrives at {f['arrival']:.3f} s, after the service end "
+                       f"{spec['service_end_s']:g} s (Eq. 26)")
         flown.append(f)
     t_out, t_back = spec["gaps"]
     for chain in by_aircraft.values():

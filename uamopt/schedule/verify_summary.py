@@ -9,6 +9,7 @@ from __future__ import annotations
 import json
 import math
 from pathlib import Path
+from typing import TypeGuard
 
 from uamopt.errors import InputFileError
 
@@ -30,7 +31,7 @@ def read_json(path: Path, fix: str = "rewrite the file with uamopt schedule"):
         raise InputFileError(f"malformed JSON: {' '.join(str(exc).split())}", str(path), fix) from None
 
 
-def finite(value) -> bool:
+def finite(value) -> TypeGuard[float]:
     """A JSON number (not a bool) that is finite as a float: NaN, inf and an integer beyond the
     float range (JSON allows 400 digits; ``math.isfinite`` would overflow) are not."""
     if isinstance(value, bool) or not isinstance(value, (int, float)):

@@ -30,6 +30,7 @@ the verifier does not know is a violation ("cannot be checked"), never a pass.
 from __future__ import annotations
 
 import hashlib
+import itertools
 import math
 from pathlib import Path
 
@@ -88,13 +89,15 @@ def _check_airland(record: dict, summary: dict, landing: dict[str, float | None]
         times.append(x)
     for i in range(len(head)):
         for j in range(i + 1, len(head)):
-            if times[i] is None or times[j] is None:
+            t_i, t_j = times[i], times[j]
+            if t_i is None or t_j is None:
                 continue
-            if not (times[j] >= times[i] + sep[i][j] - TOL or times[i] >= times[j] + sep[j][i] - TOL):
-                out.append(f"aircraft a{i + 1} and a{j + 1}: land at {times[i]:g} and {times[j]:g}, closer than "
+            if not (t_j >= t_i + sep[i][j] - TOL or t_i >= t_j + sep[j][i] - TOL):
+                out.append(f"aircraft a{i + 1} and a{j + 1}: land at {t_i:g} and {t_j:g}, closer than "
                            f"their separation ({sep[i][j]:g} after a{i + 1}, {sep[j][i]:g} after a{j + 1})")
-    if all(x is not None for x in times) and summary.get("objective") is not None:
-        cost = sum(g * max(0.0, t - x) + h * max(0.0, x - t) for (_, _, t, _, g, h), x in zip(head, times))
+    landed = [x for x in times if x is not None]
+    if len(landed) == len(times) and summary.get("objective") is not None:
+        cost = sum(g * max(0.0, t - x) + h * max(0.0, x - t) for (_, _, t, _, g, h), x in zip(head, landed, strict=True))
         got = summary["objective"]
         if _objective_off(got, cost):
             out.append(f"summary.json: objective = {shown(got)}, the landing times cost {cost:.6g} (earliness/tardiness)")
@@ -108,14 +111,16 @@ def _check_spacing(record: dict, flown: list[dict], where: str) -> list[str]:
     if isinstance(spacing, bool) or not isinstance(spacing, (int, float)) or not 0 <= spacing < 1e7:
         raise InputFileError(f"departure_spacing: spacing_s must be a number of seconds ≥ 0, got {spacing!r}", where,
                              "rewrite it with uamopt schedule")
-    out, by_origin = [], {}
+    out: list[str] = []
+    by_origin: dict[tuple[float, ...], list[dict]] = {}
     for f in flown:
         by_origin.setdefault(tuple(round(v, 3) for v in f["waypoints"][0][:2]), []).append(f)
     for origin, group in sorted(by_origin.items()):
         group.sort(key=lambda f: f["departure"])
-        for a, b in zip(group, group[1:]):
+        for a, b in itertools.pairwise(group):
             if b["departure"] - a["departure"] < spacing - TOL:
-                out.append(f"flights {a['id']} and {b['id']}: leave ({origin[0]:g}, {origin[1]:g}) {b['departure'] - a['departure']:.3f} s apart, "
+                out.append(f"flights {a['id']} and {b['id']}: leave ({origin[0]:g}, {origin[1]:g}) "
+                           f"{b['departure'] - a['departure']:.3f} s apart, "
                            f"less than the departure spacing {spacing:g} s")
     return out
 

@@ -94,7 +94,8 @@ def pair_separations(tracks: dict[str, tuple[np.ndarray, np.ndarray]], aircraft:
         k, h = int(np.argmin(normalised)), int(np.argmin(horizontal))
         out.append({
             "flights": [a, b], "near_steps": int(inside_near.sum()),
-            "closest_step": int(common[k]), "closest_horizontal_m": float(horizontal[k]), "closest_vertical_m": float(vertical[k]),
+            "closest_step": int(common[k]), "closest_horizontal_m": float(horizontal[k]),
+            "closest_vertical_m": float(vertical[k]),
             "closest_normalised": float(normalised[k]), "los_steps": int((normalised < 1.0).sum()),
             "min_horizontal_step": int(common[h]), "min_horizontal_m": float(horizontal[h]),
             "vertical_at_min_horizontal_m": float(vertical[h]),

@@ -66,12 +66,12 @@ def run(scn: str, out: str, workdir: str, until_s: float) -> dict:
         for pair in now - los_open.keys():
             los_open[pair] = t_state
         for pair in set(los_open) - now:
-            los_events.append(sorted(pair) + [los_open.pop(pair), t_state])
+            los_events.append([*sorted(pair), los_open.pop(pair), t_state])
         if traf.ntraf == 0 and not bs.stack.get_scendata()[0] and acids:
             break
     for pair, t0 in los_open.items():
-        los_events.append(sorted(pair) + [t0, float(bs.sim.simt)])
-    cat = [np.concatenate(c) if chunks else np.empty(0) for c in zip(*chunks)] if chunks else [np.empty(0)] * 5
+        los_events.append([*sorted(pair), t0, float(bs.sim.simt)])
+    cat = [np.concatenate(c) if chunks else np.empty(0) for c in zip(*chunks, strict=True)] if chunks else [np.empty(0)] * 5
     meta = {"acids": acids, "actypes": actypes, "los": los_events, "dt_s": float(bs.sim.simdt),
             "end_s": float(bs.sim.simt), "steps": steps, "wall_s": time.perf_counter() - started,
             "cpu_s": time.process_time() - started_cpu, "process_cpu_s": time.process_time(),

@@ -2,7 +2,8 @@
 
 A solver never builds the model: it takes a :class:`~uamopt.schedule.SchedulingProblem` as data
 and returns a :class:`~uamopt.schedule.Schedule` (status, objective, bound, gap, time, seed).
-Profiles are TOML files in ``solvers/`` naming a solver and its options::
+Profiles are TOML files naming a solver and its options; the shipped ones are package data in
+``uamopt/solvers/profiles/`` (a checkout's ``solvers/`` links there; :mod:`uamopt.shipped`)::
 
     solver = "highs"        # greedy | ga | soa | highs | cpsat | rolling | timeindexed
     time_limit_s = 60.0
@@ -23,6 +24,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from uamopt.errors import ScenarioError, UamoptError
+from uamopt.optional import missing_extra, require
+from uamopt.shipped import profile_path, profiles_dir
 
 if TYPE_CHECKING:
     from uamopt.schedule import Schedule, SchedulingProblem
@@ -37,7 +40,8 @@ SOLVERS = {
     "rolling": "uamopt.solvers.rolling",
     "timeindexed": "uamopt.solvers.timeindexed",
 }
-PROFILE_DIR = Path(__file__).resolve().parents[2] / "solvers"
+#: the shipped profiles (package data, read with importlib.resources: :func:`uamopt.shipped.profiles_dir`)
+PROFILE_DIR = profiles_dir()
 _KEYS = {"solver", "time_limit_s", "seed", "threads", "options", "description"}
 
 
@@ -61,7 +65,10 @@ class SolverProfile:
             raise UamoptError(f"unknown solver {self.solver!r}", f"profile {self.name or self.solver}",
                               f"use one of {', '.join(SOLVERS)}")
         check_profile_fields(self.name or self.solver, self.time_limit_s, self.seed, self.threads)
-        check_options(self.solver, self.options, self.name or self.solver)
+        try:  # options passed through to HiGHS or CP-SAT are checked by them: the [exact] extra
+            check_options(self.solver, self.options, self.name or self.solver)
+        except ModuleNotFoundError as exc:
+            raise (missing_extra(exc, f"the {self.solver} solver") or exc) from None
 
     def option(self, key: str, default=None):
         """The typed value of option ``key`` (checked on creation), else its declared default
@@ -76,13 +83,17 @@ class SolverProfile:
 
 
 def load_profile(name_or_path: str | Path) -> SolverProfile:
-    """A profile by path (``solvers/highs.toml``) or bare name (``highs``, looked up in solvers/)."""
+    """A profile by path (``solvers/highs.toml``) or bare name (``highs``, looked up in the shipped
+    profiles, :data:`PROFILE_DIR`). A relative ``solvers/NAME.toml`` that is no file where the command
+    runs (outside a checkout) is the shipped profile of that name."""
     text = str(name_or_path)
     path = Path(text)
     if not path.suffix:
         path = PROFILE_DIR / f"{text}.toml"
         if not path.is_file() and text in SOLVERS:
             return SolverProfile(solver=text, name=text)
+    else:
+        path = Path(profile_path(text))
     if not path.is_file():
         raise UamoptError(f"solver profile not found: {text}", "--solver",
                           f"give a profile file or one of {', '.join(sorted(p.stem for p in PROFILE_DIR.glob('*.toml')))}")
@@ -130,14 +141,36 @@ def unsupported(module, problem: SchedulingProblem) -> str | None:
     return None
 
 
+#: the packages of the [exact] extra each exact solver imports (on use: looked up, not imported, up front)
+NEEDS = {"highs": ("pyomo",), "cpsat": ("ortools",), "rolling": ("ortools", "pyomo"), "timeindexed": ("ortools",)}
+
+
+def solver_module(solver: str):
+    """The module of ``solver`` (:data:`SOLVERS`; the enumeration oracle for any other name); a
+    solver whose package is an extra not installed is a :class:`~uamopt.optional.MissingExtraError`."""
+    require(*NEEDS.get(solver, ()), extra="exact", what=f"the {solver} solver")
+    try:
+        return importlib.import_module(SOLVERS[solver] if solver in SOLVERS else BRUTEFORCE)
+    except ModuleNotFoundError as exc:
+        raise (missing_extra(exc, f"the {solver} solver") or exc) from None
+
+
+def _installed(solver: str) -> bool:
+    try:
+        solver_module(solver)
+    except ImportError:
+        return False
+    return True
+
+
 def check_supported(solver: str, problem: SchedulingProblem, where: str | None = None) -> None:
     """Refuse, before any work, a problem with a family or objective the solver has no encoder for:
     one line naming it and the solvers that support it."""
-    module = importlib.import_module(SOLVERS[solver] if solver in SOLVERS else BRUTEFORCE)
+    module = solver_module(solver)
     missing = unsupported(module, problem)
     if missing is None:
         return
-    able = [name for name, path in SOLVERS.items() if unsupported(importlib.import_module(path), problem) is None]
+    able = [name for name in SOLVERS if _installed(name) and unsupported(solver_module(name), problem) is None]
     raise UamoptError(f"solver {solver} has no encoder for the {missing}", where or f"solver {solver}",
                       f"use one of: {', '.join(able)}" if able else "no solver supports this problem")
 
@@ -151,16 +184,19 @@ def solve(problem: SchedulingProblem, profile: SolverProfile | str, *, extra=Non
     if not isinstance(profile, SolverProfile):
         profile = load_profile(profile)
     check_supported(profile.solver, problem, f"profile {profile.name or profile.solver}")
-    module = importlib.import_module(SOLVERS[profile.solver])
+    module = solver_module(profile.solver)
     if extra is not None and profile.solver not in EXTRA:
         raise UamoptError(f"solver {profile.solver} takes no extra= callback", f"profile {profile.name or profile.solver}",
                           f"use one of {', '.join(EXTRA)}, whose models the callback can edit")
     from uamopt.schedule.families.speed import speed_choice_of
 
     choice = speed_choice_of(problem)
-    if choice is not None and profile.solver in SPEED_FIRST and extra is None:
-        return _speed_solve(problem, profile, module, choice)
-    schedule = module.solve(problem, profile) if extra is None else module.solve(problem, profile, extra=extra)
+    try:  # a solver's own lazy imports (OR-Tools, HiGHS inside rolling, timeindexed): the [exact] extra
+        if choice is not None and profile.solver in SPEED_FIRST and extra is None:
+            return _speed_solve(problem, profile, module, choice)
+        schedule = module.solve(problem, profile) if extra is None else module.solve(problem, profile, extra=extra)
+    except ModuleNotFoundError as exc:
+        raise (missing_extra(exc, f"the {profile.solver} solver") or exc) from None
     schedule.extras.setdefault("model_kind", model_kind(profile, problem))
     return schedule
 

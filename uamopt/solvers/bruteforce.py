@@ -53,13 +53,14 @@ def _lp(problem: SchedulingProblem, flown: list[int], rows: list[tuple[int, int,
         a_ub[r, col[i]] += 1.0
         a_ub[r, col[j]] -= 1.0
         b_ub[r] = b
-    bounds = [(0.0, float(problem.delay_upper_s[f])) for f in flown]
+    bounds: list[tuple[float, float | None]] = [(0.0, float(problem.delay_upper_s[f])) for f in flown]
     if o.per_flight_terms:
-        cost = np.concatenate([np.zeros(m), o.early_per_s[flown], o.late_per_s[flown]])
+        target, early, late = o.terms
+        cost = np.concatenate([np.zeros(m), early[flown], late[flown]])
         for k, f in enumerate(flown):
             r = len(rows) + 2 * k
-            a_ub[r, k], a_ub[r, m + k], b_ub[r] = -1.0, -1.0, -float(o.target_s[f])  # a − d ≤ E
-            a_ub[r + 1, k], a_ub[r + 1, 2 * m + k], b_ub[r + 1] = 1.0, -1.0, float(o.target_s[f])  # d − a ≤ L
+            a_ub[r, k], a_ub[r, m + k], b_ub[r] = -1.0, -1.0, -float(target[f])  # a − d ≤ E
+            a_ub[r + 1, k], a_ub[r + 1, 2 * m + k], b_ub[r + 1] = 1.0, -1.0, float(target[f])  # d − a ≤ L
         bounds += [(0.0, None)] * extra
     else:
         cost = np.ones(m)
@@ -98,10 +99,10 @@ def least_delay(problem: SchedulingProblem, operated: np.ndarray) -> tuple[float
         return 0.0, np.zeros(problem.n_flights)
     t = problem.turnaround  # d_f − d_e ≥ need  ⇔  d_e − d_f ≤ −need (families/turnaround.py)
     both = operated[t.e] & operated[t.f]
-    fixed = list(zip(t.e[both].tolist(), t.f[both].tolist(), (-t.need_s[both]).tolist()))
+    fixed = list(zip(t.e[both].tolist(), t.f[both].tolist(), (-t.need_s[both]).tolist(), strict=True))
     branching = []
     view = problem.pairs  # the admissible-gap view (uamopt.schedule.core)
-    for k, (p, q) in enumerate(zip(view.p.tolist(), view.q.tolist())):
+    for k, (p, q) in enumerate(zip(view.p.tolist(), view.q.tolist(), strict=True)):
         gaps = view.gaps_of(k)
         if not (operated[p] and operated[q]):
             continue
@@ -148,7 +149,8 @@ def solve(problem: SchedulingProblem, profile=None) -> Schedule:
     """
     n = problem.n_flights
     if n > MAX_FLIGHTS:
-        raise UamoptError(f"{n} flights is too many for the brute force", "bruteforce", f"use at most {MAX_FLIGHTS} or the highs solver")
+        raise UamoptError(f"{n} flights is too many for the brute force", "bruteforce",
+                          f"use at most {MAX_FLIGHTS} or the highs solver")
     start = time.perf_counter()
     must, objective = problem.must_operate, problem.objective
     groups = [g for family in problem.of_shape("precedence") for g in family.groups()]

@@ -39,13 +39,17 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from uamopt.errors import UamoptError
 from uamopt.interrupts import stopping
 from uamopt.schedule.flights import TIME_TOL_S
-from uamopt.schedule.model import Schedule, SchedulingProblem, make_schedule
+from uamopt.schedule.model import Schedule, SchedulingProblem, Status, make_schedule
+
+if TYPE_CHECKING:
+    from ortools.sat.python import cp_model
 
 ROUND_S = 1e-9  # float round-off accepted when rounding a real time to units, s
 INT_LIMIT = 2**62  # keep |objective| below this (CP-SAT uses int64)
@@ -84,16 +88,19 @@ def integer_terms(problem: SchedulingProblem, unit_s: float, delay_max: np.ndarr
     from fractions import Fraction
 
     o = problem.objective
-    target = o.target_s / unit_s
+    target_s, early_per_s, late_per_s = o.terms
+    assert o.exact is not None, "Objective.earliness_tardiness sets the exact weights"
+    target = target_s / unit_s
     target_k = np.rint(target).astype(np.int64)
     fr_u = Fraction(repr(float(unit_s)))
-    early = [Fraction(repr(float(c))) * fr_u for c in o.early_per_s]
-    late = [Fraction(repr(float(c))) * fr_u for c in o.late_per_s]
+    early = [Fraction(repr(float(c))) * fr_u for c in early_per_s]
+    late = [Fraction(repr(float(c))) * fr_u for c in late_per_s]
     reward = o.exact[1]
     scale = math.lcm(*(x.denominator for x in early + late + [reward]))
     e_int = np.array([int(x * scale) for x in early], dtype=object)
     l_int = np.array([int(x * scale) for x in late], dtype=object)
-    worst = sum(int(a) * int(m) + int(b) * int(m) for a, b, m in zip(e_int, l_int, delay_max)) + int(reward * scale) * len(delay_max)
+    worst = (sum(int(a) * int(m) + int(b) * int(m) for a, b, m in zip(e_int, l_int, delay_max, strict=True))
+             + int(reward * scale) * len(delay_max))
     how = "exact" if np.all(np.abs(target - target_k) <= 1e-9) else "approximate"
     if worst >= INT_LIMIT:
         raise UamoptError("the earliness/tardiness costs overflow CP-SAT's 64-bit objective", "solver cpsat",
@@ -105,7 +112,7 @@ def integer_terms(problem: SchedulingProblem, unit_s: float, delay_max: np.ndarr
 class _Vars:
     """What the encoders share: the model, c_f, k_f (delay in units), the unit, the rounding."""
 
-    model: object
+    model: cp_model.CpModel
     operate: list
     delay: list
     delay_max: np.ndarray
@@ -134,7 +141,7 @@ def encode_precedence(v: _Vars, problem: SchedulingProblem, family) -> None:
 def encode_turnaround(v: _Vars, problem: SchedulingProblem, family=None) -> None:
     """k_f − k_e ≥ ⌈need/u⌉ if c_e ∧ c_f, for every row of ``problem.turnaround``."""
     t, eta, u = problem.turnaround, v.eta, v.unit_s
-    for e, f, need in zip(t.e.tolist(), t.f.tolist(), t.need_s.tolist()):
+    for e, f, need in zip(t.e.tolist(), t.f.tolist(), t.need_s.tolist(), strict=True):
         need = (math.ceil(need / u - eta) if v.rounding == "outer"
                 else math.floor((need - TIME_TOL_S) / u - 1 - eta) + 1)
         if need > -v.delay_max[e]:
@@ -146,16 +153,16 @@ def encode_pairs(v: _Vars, problem: SchedulingProblem, family=None) -> None:
     from ortools.util.python.sorted_interval_list import Domain
 
     view, eta, u, operate, delay = problem.pairs, v.eta, v.unit_s, v.operate, v.delay
-    for k, (p, q) in enumerate(zip(view.p.tolist(), view.q.tolist())):
+    for k, (p, q) in enumerate(zip(view.p.tolist(), view.q.tolist(), strict=True)):
         shift, rows = float(view.shift[k]), slice(view.ptr[k], view.ptr[k + 1])
         reach = Domain(-int(v.delay_max[p]), int(v.delay_max[q]))
         if v.rounding == "outer":
             forbidden = [[math.floor((lo - shift) / u + eta) + 1, math.ceil((hi - shift) / u - eta) - 1]
-                         for lo, hi in zip(view.lo[rows].tolist(), view.hi[rows].tolist())]
+                         for lo, hi in zip(view.lo[rows].tolist(), view.hi[rows].tolist(), strict=True)]
         else:
             forbidden = [[math.ceil((lo + TIME_TOL_S - shift) / u + 1 + eta),
                           math.floor((hi - TIME_TOL_S - shift) / u - 1 - eta)]
-                         for lo, hi in zip(view.lo[rows].tolist(), view.hi[rows].tolist())]
+                         for lo, hi in zip(view.lo[rows].tolist(), view.hi[rows].tolist(), strict=True)]
         forbidden = [iv for iv in forbidden if iv[0] <= iv[1]]
         allowed = reach.intersection_with(Domain.from_intervals(forbidden).complement()) if forbidden else reach
         if allowed.is_empty():
@@ -308,9 +315,9 @@ def solve(problem: SchedulingProblem, profile, extra=None) -> Schedule:
 
     Then (option ``continuous_bound``, default true) the ``inner`` model (cells of width u, a
     relaxation) is solved, hinted with that solution, for the rest of the time limit (skipped when
-    less than 0.5 s is left; the limit covers both models' building): its bound L is valid for continuous delays, so OPT ∈ [L, objective] and the summary gives
-    ``continuous_bound`` = L and ``optimal_within`` = objective − L (an ε proved on this instance;
-    no a-priori ε exists, since a feasible window narrower than u may hold no lattice point).
+    less than 0.5 s is left; the limit covers both models' building): its bound L is valid for continuous delays, so
+    OPT ∈ [L, objective] and the summary gives ``continuous_bound`` = L and ``optimal_within`` = objective − L (an ε
+    proved on this instance; no a-priori ε exists, since a feasible window narrower than u may hold no lattice point).
     """
     import time
 
@@ -326,9 +333,11 @@ def solve(problem: SchedulingProblem, profile, extra=None) -> Schedule:
     model, operate, delay, _, per_flight, divisor, how = build_cpsat(small, unit_s, extra=extra)
     start = no_start() if extra is not None else warm_start(problem, seed=profile.seed, on_grid=True)
     # (a heuristic schedule knows nothing of the callback's rows: no start, and no fallback to one)
-    for f in range(problem.n_flights if start.found else 0):
-        model.add_hint(operate[f], bool(start.operated[f]))
-        model.add_hint(delay[f], int(np.rint(start.delay_s[f] / unit_s)) if start.operated[f] else 0)
+    if start.found:
+        hint_operated, hint_delay = start.decisions
+        for f in range(problem.n_flights):
+            model.add_hint(operate[f], bool(hint_operated[f]))
+            model.add_hint(delay[f], int(np.rint(hint_delay[f] / unit_s)) if hint_operated[f] else 0)
     build_s = time.perf_counter() - t0  # model, warm start and hints
     solver = _solver(profile, options, max(0.05, profile.time_limit_s - build_s))  # the limit covers the build too
     with stopping(solver.stop_search):  # Ctrl-C and SIGTERM stop the search at once
@@ -357,14 +366,18 @@ def solve(problem: SchedulingProblem, profile, extra=None) -> Schedule:
     delay_s = np.array(delay_k, dtype=float) * unit_s
     # OPTIMAL proves the u-lattice model, a restriction: optimal_on_grid unless the continuous bound
     # below closes the gap; the lattice bound is no bound of the continuous problem (extras only).
-    exact = lattice_is_exact(problem, unit_s, how)  # (the data, not the dominance caps of `small`) then the lattice's optimum and bound are the continuous ones
-    status = ("optimal" if exact else "optimal_on_grid") if code == cp_model.OPTIMAL else "time_limit"  # FEASIBLE: the limit
+    # When the lattice is exact (the data, not the dominance caps of `small`), its optimum and bound are the continuous ones.
+    exact = lattice_is_exact(problem, unit_s, how)
+    status: Status = (("optimal" if exact else "optimal_on_grid") if code == cp_model.OPTIMAL
+                      else "time_limit")  # FEASIBLE: the limit
     lattice_bound = objective_bound(problem, solver.best_objective_bound, per_flight, divisor, unit_s, how)
     extras.update(restricted_bound=lattice_bound, lattice_exact=exact)
     schedule = no_worse(problem, make_schedule(problem, "cpsat", status, operated, delay_s,
                                                bound=lattice_bound if exact else None,
                                                solve_seconds=seconds, seed=profile.seed, extras=extras), start)
-    if want_bound and schedule.status == "optimal" and schedule.bound is not None:  # the exact lattice's bound is continuous-valid
+    assert schedule.objective is not None, "only an infeasible schedule has no objective (make_schedule)"
+    # the exact lattice's bound is continuous-valid
+    if want_bound and schedule.status == "optimal" and schedule.bound is not None:
         schedule.extras.update(continuous_bound=schedule.bound, continuous_bound_model="the exact lattice (lattice_exact)",
                                optimal_within=schedule.objective - schedule.bound)
     elif want_bound and profile.time_limit_s - (time.perf_counter() - t0) > 0.5:

@@ -53,14 +53,14 @@ import numpy as np
 
 from uamopt.bounds import MAX_TIME_S, Range, check_number, shown
 from uamopt.errors import UamoptError
-from uamopt.schedule.model import Schedule, SchedulingProblem, make_schedule
+from uamopt.schedule.model import Schedule, SchedulingProblem, Status, make_schedule
 from uamopt.solvers.greedy import (  # noqa: F401  (SHAPES, OBJECTIVES: the decoder's, uamopt.solvers.check_supported)
-    OBJECTIVES,
-    SHAPES,
-    base_genes,
     CANCEL,
     DEFAULT_STEP_S,
     EPS_S,
+    OBJECTIVES,
+    SHAPES,
+    base_genes,
     decoder_for,
 )
 from uamopt.solvers.options import refuse_unknown
@@ -101,7 +101,8 @@ class GeneticOptions:
             if kind is int and isinstance(value, float) and value.is_integer():
                 value = int(value)  # 50.0 is 50 (TOML writes what a table generator gave)
             if isinstance(value, bool) or (kind is int and not isinstance(value, int)):
-                raise UamoptError(f"option {key} must be {kind.__name__}, got {shown(value)}", f"solver {solver}", "fix the profile")
+                raise UamoptError(f"option {key} must be {kind.__name__}, got {shown(value)}", f"solver {solver}",
+                                  "fix the profile")
             valid = GENETIC_RANGES[key]
             kw[key] = check_number(value, f"option {key}", f"solver {solver}", f"use {valid.text()}", valid, error=UamoptError)
         return cls(**kw)
@@ -294,7 +295,7 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
               "greedy_objective": float(w[0]), "history": best.history}
     if profile.solver == "soa":
         extras["final_temperature"] = opts.t0 * opts.xi ** max(generations - 1, 0)
-    status = ("infeasible" if np.any(problem.must_operate & ~best.operated)
+    status: Status = ("infeasible" if np.any(problem.must_operate & ~best.operated)
               else "time_limit" if timed_out else "feasible")
     return make_schedule(problem, profile.solver, status, best.operated, best.delay,
                          solve_seconds=time.perf_counter() - start, seed=profile.seed, extras=extras)

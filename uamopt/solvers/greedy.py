@@ -2,16 +2,16 @@
 
 Preliminary strategy
 --------------------
-Flights are taken in the conflict-resolution order f' = order of planned departure D (ties: flight
-index); flights that must operate (``problem.must_operate``, none in the paper's model) come first. Flight f is checked against every flight placed before it (Fig. 11): its departure starts
-at the earliest admissible time, max(D_f, arrival + ΔT of its aircraft's previous *operated* flight)
-(Eqs. 27-28), and while it conflicts with an already placed operated flight — dep_f lies in one of
-that pair's forbidden open intervals (``problem.pairs``, uamopt.schedule.core; the 3×3×3 zone of
-Fig. 13) — it is delayed past the interval's end (Fig. 12). Delays are whole multiples of
-ΔT_a (``step_s``, Table B.3: 10 s), so a delay is rounded *up* to the step; with ``exact_gaps``
-the flight goes exactly to the gap's end instead. When the delay needed exceeds the flight's
-threshold, min(Δd_f, T_f − A_f) (Eqs. 26, 29), the flight is cancelled; a cancelled outbound
-cancels its return (docs/readings.md: the aircraft never left). The result is feasible by construction,
+Flights are taken in the conflict-resolution order f' = order of planned departure D (ties: flight index); flights
+that must operate (``problem.must_operate``, none in the paper's model) come first. Flight f is checked against every
+flight placed before it (Fig. 11): its departure starts at the earliest admissible time, max(D_f, arrival + ΔT of its
+aircraft's previous *operated* flight) (Eqs. 27-28), and while it conflicts with an already placed operated flight —
+dep_f lies in one of that pair's forbidden open intervals (``problem.pairs``, uamopt.schedule.core; the 3×3×3 zone of
+Fig. 13) — it is delayed past the interval's end (Fig. 12). Delays are whole multiples of ΔT_a (``step_s``, Table B.3:
+10 s), so a delay is rounded *up* to the step; with ``exact_gaps`` the flight goes exactly to the gap's end instead.
+When the delay needed exceeds the flight's threshold, min(Δd_f, T_f − A_f) (Eqs. 26, 29), the flight is cancelled; a
+cancelled outbound cancels its return (docs/readings.md: the aircraft never left). The result is feasible by
+construction,
 except that a must-operate flight that cannot be placed is cancelled too (status ``infeasible``).
 
 Decoder (shared with :mod:`uamopt.solvers.genetic`)
@@ -35,7 +35,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from uamopt.schedule.model import Schedule, SchedulingProblem, make_schedule
+from uamopt.schedule.model import Schedule, SchedulingProblem, Status, make_schedule
 
 CANCEL = -1  # gene value meaning "cancel this flight" (Fig. 14 extended with a cancel allele)
 DEFAULT_STEP_S = 10.0  # ΔT_a, s (Table B.3)
@@ -100,7 +100,7 @@ class Decoder:
             base = len(capacity)
             capacity += [int(c) for c in rest.capacity]
             for f_, r, o_, l_ in zip(rest.flight.tolist(), rest.resource.tolist(), rest.offset_s.tolist(),
-                                     rest.duration_s.tolist()):
+                                     rest.duration_s.tolist(), strict=True):
                 holds[f_].append((base + r, o_, l_))
         return cls(order=order, ptr=np.concatenate([[0], np.cumsum(counts)]).astype(np.int64),
                    partner=partner[rows], lo=rel_lo[rows], hi=rel_hi[rows],
@@ -214,7 +214,8 @@ class Decoder:
         return operated, delay
 
 
-SHAPES = frozenset({"bounds", "must_operate", "precedence", "turnaround", "pairs", "cumulative"})  # the decoder's view (from_problem)
+#: the decoder's view (from_problem)
+SHAPES = frozenset({"bounds", "must_operate", "precedence", "turnaround", "pairs", "cumulative"})
 OBJECTIVES = frozenset({"weighted", "lexicographic", "earliness_tardiness"})
 
 _DECODERS: weakref.WeakKeyDictionary[SchedulingProblem, Decoder] = weakref.WeakKeyDictionary()
@@ -250,6 +251,6 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
     step_s, exact = profile.option("step_s", problem.time_step_s), profile.option("exact_gaps")
     start = time.perf_counter()
     operated, delay = greedy_decisions(problem, step_s, exact)
-    status = "infeasible" if np.any(problem.must_operate & ~operated) else "feasible"
+    status: Status = "infeasible" if np.any(problem.must_operate & ~operated) else "feasible"
     return make_schedule(problem, "greedy", status, operated, delay, solve_seconds=time.perf_counter() - start,
                          seed=profile.seed, extras={"step_s": step_s, "exact_gaps": exact})

@@ -47,6 +47,7 @@ from __future__ import annotations
 
 import logging
 import time
+from collections.abc import Sequence
 
 import numpy as np
 import pyomo.environ as pyo
@@ -56,7 +57,7 @@ from pyomo.contrib.solver.common.results import SolutionStatus, TerminationCondi
 from uamopt.errors import UamoptError
 from uamopt.interrupts import quiet_on_interrupt, stopping
 from uamopt.schedule.flights import TIME_TOL_S
-from uamopt.schedule.model import Schedule, SchedulingProblem, make_schedule
+from uamopt.schedule.model import Schedule, SchedulingProblem, Status, make_schedule
 from uamopt.solvers.deadline import interrupt_at
 
 quiet_on_interrupt("pyomo.core")  # Ctrl-C while a model is built: no "ERROR: Constructing component" line
@@ -108,7 +109,8 @@ def define_must_operate(m: pyo.ConcreteModel, problem: SchedulingProblem, family
 def define_precedence(m: pyo.ConcreteModel, problem: SchedulingProblem, family) -> None:
     """(a) c_f ≤ Σ_{g ∈ group} c_g: a cancelled outbound cancels its return (groups of one in the paper)."""
     rows = family.groups()
-    block = pyo.Constraint(range(len(rows)), rule=lambda m, r: m.operate[rows[r][0]] <= sum(m.operate[int(g)] for g in rows[r][1]))
+    block = pyo.Constraint(range(len(rows)),
+                           rule=lambda m, r: m.operate[rows[r][0]] <= sum(m.operate[int(g)] for g in rows[r][1]))
     m.add_component(family.name if not hasattr(m, family.name) else f"{family.name}_{len(m.component_map())}", block)
 
 
@@ -116,7 +118,7 @@ def define_turnaround(m: pyo.ConcreteModel, problem: SchedulingProblem, family=N
     """(b) Eq. 27 for every ordered pair of one aircraft's flights (``problem.turnaround``), tight big-M."""
     t, upper = problem.turnaround, problem.delay_upper_s
     rows = {}
-    for e, f, need in zip(t.e.tolist(), t.f.tolist(), t.need_s.tolist()):  # d_f − d_e must reach need
+    for e, f, need in zip(t.e.tolist(), t.f.tolist(), t.need_s.tolist(), strict=True):  # d_f − d_e must reach need
         if need + upper[e] > 0:
             rows[e, f] = (need, max(need + upper[e], 0.0), max(need, 0.0))
     m.turnaround = pyo.Constraint(list(rows), rule=lambda m, e, f: m.delay[f] - m.delay[e] >= rows[e, f][0]
@@ -128,7 +130,9 @@ def define_conflicts(m: pyo.ConcreteModel, problem: SchedulingProblem, family=No
     merged view of every ``pairs`` family (``problem.pairs``)."""
     dep = problem.planned_departure_s
     m.gaps_of = admissible_gaps(problem)
-    never, single, multi = [], [], []
+    never: list[int] = []
+    single: list[int] = []
+    multi: list[int] = []
     for k, (_, _, gaps, _, _) in enumerate(m.gaps_of):
         (never if not gaps else single if len(gaps) == 1 else multi).append(k)
     m.not_both = pyo.Constraint(never, rule=lambda m, k: m.operate[m.gaps_of[k][0]] + m.operate[m.gaps_of[k][1]] <= 1)
@@ -225,7 +229,7 @@ def define_objective(m: pyo.ConcreteModel, problem: SchedulingProblem) -> None:
     if o.operate_cost_s is not None:  # per-flight operating costs in seconds of delay (a speed change)
         expr = expr + o.per_delay * sum(float(o.operate_cost_s[f]) * m.operate[f] for f in m.flights)
     if o.per_flight_terms:
-        a, e_cost, l_cost = o.target_s, o.early_per_s, o.late_per_s
+        a, e_cost, l_cost = o.terms
         m.early = pyo.Var(m.flights, bounds=(0.0, None))
         m.late = pyo.Var(m.flights, bounds=(0.0, None))
         m.early_row = pyo.Constraint(m.flights, rule=lambda m, f: m.early[f] >= float(a[f]) * m.operate[f] - m.delay[f])
@@ -266,7 +270,7 @@ def build_model(problem: SchedulingProblem, extra=None) -> pyo.ConcreteModel:
 
 
 def least_delays(problem: SchedulingProblem, operated: np.ndarray, chosen: dict[int, tuple[float, float]],
-                 orders: list[tuple[int, int, float]] = ()) -> np.ndarray | None:
+                 orders: Sequence[tuple[int, int, float]] = ()) -> np.ndarray | None:
     """The least delays (minimal Σ d) of the operated flights for fixed gap choices, or None if none fit.
 
     ``chosen`` maps a pair's row in ``admissible_gaps`` to its gap [g, h]; ``orders`` adds edges
@@ -275,7 +279,8 @@ def least_delays(problem: SchedulingProblem, operated: np.ndarray, chosen: dict[
     """
     dep, upper, t = problem.planned_departure_s, problem.delay_upper_s, problem.turnaround
     both = operated[t.e] & operated[t.f]
-    edges = list(zip(t.e[both].tolist(), t.f[both].tolist(), t.gap_s(problem)[both].tolist()))  # (i, j, w): dep_j ≥ dep_i + w
+    # (i, j, w): dep_j ≥ dep_i + w
+    edges = list(zip(t.e[both].tolist(), t.f[both].tolist(), t.gap_s(problem)[both].tolist(), strict=True))
     edges += list(orders)
     for k, (low, high) in chosen.items():
         p, q = int(problem.pairs.p[k]), int(problem.pairs.q[k])
@@ -295,7 +300,7 @@ def least_delays(problem: SchedulingProblem, operated: np.ndarray, chosen: dict[
 
 
 def least_cost_delays(problem: SchedulingProblem, operated: np.ndarray, chosen: dict[int, tuple[float, float]],
-                      orders: list[tuple[int, int, float]] = ()) -> np.ndarray | None:
+                      orders: Sequence[tuple[int, int, float]] = ()) -> np.ndarray | None:
     """The earliness/tardiness objective's optimal delays for fixed gap choices: the LP
     min Σ e_f E_f + l_f L_f over the same difference constraints as :func:`least_delays`
     (scipy's HiGHS, exact to its tolerances), or None if it fails."""
@@ -310,13 +315,14 @@ def least_cost_delays(problem: SchedulingProblem, operated: np.ndarray, chosen: 
     col[flown] = np.arange(len(flown))
     rows = []  # (i, j, b): d_i − d_j ≤ b
     both = operated[t.e] & operated[t.f]
-    rows += list(zip(t.e[both].tolist(), t.f[both].tolist(), (-t.need_s[both]).tolist()))
+    rows += list(zip(t.e[both].tolist(), t.f[both].tolist(), (-t.need_s[both]).tolist(), strict=True))
     dep = problem.planned_departure_s
     for k, (low, high) in chosen.items():
         p, q = int(problem.pairs.p[k]), int(problem.pairs.q[k])
         shift = dep[q] - dep[p]
         rows += [(p, q, shift - low), (q, p, high - shift)]
     rows += [(i, j, float(dep[j] - dep[i] - w)) for i, j, w in orders]  # dep_j ≥ dep_i + w: d_i − d_j ≤ D_j − D_i − w
+    target, early, late = o.terms
     m = len(flown)  # variables: d (m), early (m), late (m)
     r_i, r_j, data, b = [], [], [], []
     for r, (i, j, bound) in enumerate(rows):
@@ -329,9 +335,9 @@ def least_cost_delays(problem: SchedulingProblem, operated: np.ndarray, chosen: 
         r_i += [base, base, base + 1, base + 1]
         r_j += [k, m + k, k, 2 * m + k]
         data += [-1.0, -1.0, 1.0, -1.0]
-        b += [-float(o.target_s[f]), float(o.target_s[f])]
+        b += [-float(target[f]), float(target[f])]
     a_ub = coo_matrix((data, (r_i, r_j)), shape=(len(b), 3 * m)).tocsr()
-    cost = np.concatenate([np.full(m, o.per_delay), o.early_per_s[flown], o.late_per_s[flown]])
+    cost = np.concatenate([np.full(m, o.per_delay), early[flown], late[flown]])
     upper = problem.delay_upper_s[flown]
     bounds = [(0.0, float(u)) for u in upper] + [(0.0, None)] * (2 * m)
     res = linprog(cost, A_ub=a_ub, b_ub=np.array(b), bounds=bounds, method="highs")
@@ -416,7 +422,7 @@ def solve(problem: SchedulingProblem, profile, extra=None) -> Schedule:
     build_s = time.perf_counter() - t0
     solver.set_instance(m)  # the persistent interface: load the model, then hand HiGHS the MIP start
     if start.found:
-        _set_mip_start(solver, mip_start(m, problem, start.operated, start.delay_s))
+        _set_mip_start(solver, mip_start(m, problem, *start.decisions))
     stopped: list = []
     if getattr(solver, "_solver_model", None) is not None:  # pyomo 6.10's persistent HiGHS object
         stopped = interrupt_at(solver._solver_model, t0 + profile.time_limit_s)  # where HiGHS listens (deadline.py)
@@ -441,8 +447,9 @@ def solve(problem: SchedulingProblem, profile, extra=None) -> Schedule:
     n = problem.n_flights
     if tc in (TerminationCondition.provenInfeasible, TerminationCondition.infeasibleOrUnbounded):
         extras["reason"] = infeasible_reason(problem)
-        return make_schedule(problem, "highs", "infeasible", np.zeros(n, bool), np.zeros(n), solve_seconds=time.perf_counter() - t0,
-                             seed=profile.seed, extras=extras)
+        return make_schedule(problem, "highs", "infeasible", np.zeros(n, bool), np.zeros(n),
+                             solve_seconds=time.perf_counter() - t0, seed=profile.seed, extras=extras)
+    status: Status
     if tc == TerminationCondition.convergenceCriteriaSatisfied and has_solution:
         status = "optimal"
     elif tc in (TerminationCondition.maxTimeLimit, TerminationCondition.iterationLimit, TerminationCondition.interrupted

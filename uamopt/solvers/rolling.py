@@ -65,7 +65,7 @@ import numpy as np
 from uamopt.errors import UamoptError
 from uamopt.interrupts import stopping
 from uamopt.schedule.flights import TIME_TOL_S
-from uamopt.schedule.model import Schedule, SchedulingProblem, make_schedule, violations
+from uamopt.schedule.model import Schedule, SchedulingProblem, Status, make_schedule, violations
 from uamopt.schedule.occupancy import ConflictTable
 from uamopt.solvers.greedy import greedy_decisions
 
@@ -235,7 +235,8 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
     t0 = float(dep0[order[0]]) if n else 0.0
     window_of = np.floor((dep0 - t0) / o["window_s"]).astype(np.int64)
     windows = [order[window_of[order] == w] for w in np.unique(window_of)]
-    limit = float(o["window_time_limit_s"]) if o["window_time_limit_s"] is not None else profile.time_limit_s / max(len(windows), 1)
+    limit = (float(o["window_time_limit_s"]) if o["window_time_limit_s"] is not None
+             else profile.time_limit_s / max(len(windows), 1))
     aircraft = problem.flights.aircraft_index
     pairs = np.stack([problem.pairs.p, problem.pairs.q], axis=1)  # one-pad holds included (problem.pairs)
     for family in problem.of_shape("cumulative"):  # flights whose holds can meet at a resource of more pads
@@ -283,8 +284,7 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
                 answer = _inner_highs(sub, min(limit, left), profile.threads, profile.seed)
         except UamoptError:
             answer = None
-        ok = answer is not None and not violations(sub, answer[0], answer[1])  # violations checks must-operate
-        if ok:
+        if answer is not None and not violations(sub, answer[0], answer[1]):  # violations checks must-operate
             stats["proved" if answer[2] else "unproved"] += 1
             sub_op, sub_d = answer[0], answer[1]
         else:
@@ -301,14 +301,15 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
         for f in free.tolist():  # free is in index order; chains are by departure: take the latest operated
             if operated[f]:
                 a = aircraft[f]
-                if last_operated[a] < 0 or dep0[f] > dep0[last_operated[a]] or (dep0[f] == dep0[last_operated[a]] and f > last_operated[a]):
+                last = last_operated[a]
+                if last < 0 or dep0[f] > dep0[last] or (dep0[f] == dep0[last] and f > last):
                     last_operated[a] = f
     bad = violations(problem, operated, delay)
     if bad:  # cannot happen by construction; never return an infeasible schedule
         stats["fallback"] = f"whole-problem greedy ({len(bad)} violations, first: {bad[0]})"
         operated, delay = greedy_decisions(problem, o["step_s"] and float(o["step_s"]))
-    bound = pair_matching_bound(problem)
-    status = "time_limit" if stats["unproved"] else "feasible"
+    bound: float | None = pair_matching_bound(problem)
+    status: Status = "time_limit" if stats["unproved"] else "feasible"
     if not first.found and violations(problem, operated, delay):  # as greedy: a must-operate flight not placed
         status, bound = "infeasible", None
     stats["bound_of"] = "pair-matching relaxation (rolling.py docstring)"

@@ -75,7 +75,7 @@ import numpy as np
 from uamopt.errors import UamoptError
 from uamopt.interrupts import stopping
 from uamopt.schedule.flights import TIME_TOL_S
-from uamopt.schedule.model import Schedule, SchedulingProblem, make_schedule
+from uamopt.schedule.model import Schedule, SchedulingProblem, Status, make_schedule
 from uamopt.solvers.deadline import highs_can_start, interrupt_at, quiet_highs
 from uamopt.solvers.warmstart import Start, no_schedule, no_worse, reduced, warm_start
 
@@ -135,7 +135,7 @@ class GridModel:
 def _forbidden_steps(problem: SchedulingProblem, step_s: float, kind: str, k_max: np.ndarray):
     """(p, q, z_lo, z_hi): the integer intervals of forbidden z = k_q − k_p, conflicts then turnarounds."""
     eta = ETA_S / step_s
-    dep, s = problem.planned_departure_s, step_s
+    s = step_s
     view = problem.pairs  # forbidden intervals of δ, less the pair's shift: of z = d_q − d_p (core.py)
     p, q = view.p[view.row_pair], view.q[view.row_pair]
     lo, hi = view.lo - view.shift[view.row_pair], view.hi - view.shift[view.row_pair]
@@ -214,7 +214,8 @@ def build_grid_model(problem: SchedulingProblem, step_s: float = 10.0, kind: str
     if kind not in ("grid", "relaxed"):
         raise UamoptError(f"unknown time-indexed model '{kind}'", "solver timeindexed", "use model = \"grid\" or \"relaxed\"")
     if not (math.isfinite(step_s) and step_s > 0):
-        raise UamoptError(f"step_s must be positive, got {step_s}", "solver timeindexed", "give the delay grid step in s, e.g. 10")
+        raise UamoptError(f"step_s must be positive, got {step_s}", "solver timeindexed",
+                          "give the delay grid step in s, e.g. 10")
     n = problem.n_flights
     k_max = np.floor(problem.delay_upper_s / step_s + ETA_S / step_s).astype(np.int64)
     start = np.concatenate([[0], np.cumsum(k_max + 1)]).astype(np.int64)
@@ -222,13 +223,14 @@ def build_grid_model(problem: SchedulingProblem, step_s: float = 10.0, kind: str
     k_of_col = np.arange(start[-1]) - start[flight_of_col]
     o = problem.objective
     if kind == "relaxed" and o.per_flight_terms:  # a cell's least cost: at the point nearest the target
-        at = np.clip(o.target_s[flight_of_col], k_of_col * step_s, (k_of_col + 1) * step_s)
+        at = np.clip(o.terms[0][flight_of_col], k_of_col * step_s, (k_of_col + 1) * step_s)
     else:  # the grid point; for the relaxed linear kinds the cell's lower end
         at = k_of_col * step_s
     cost = o.delay_cost(at, flight_of_col) - o.per_flight
     p, q, z_lo, z_hi = _forbidden_steps(problem, step_s, kind, k_max)
     if both_ways:
-        p, q, z_lo, z_hi = np.concatenate([p, q]), np.concatenate([q, p]), np.concatenate([z_lo, -z_hi]), np.concatenate([z_hi, -z_lo])
+        p, q = np.concatenate([p, q]), np.concatenate([q, p])
+        z_lo, z_hi = np.concatenate([z_lo, -z_hi]), np.concatenate([z_hi, -z_lo])
     # one row per (pair interval, a): b ∈ [max(0, a + z_lo), min(K_q, a + z_hi)], then rows merged per (p, q, a)
     a_count = k_max[p] + 1
     iv = np.repeat(np.arange(len(p)), a_count)
@@ -320,9 +322,10 @@ def _highs(model: GridModel, deadline: float, threads: int, seed: int, gap: floa
                   np.array(cols, dtype=np.int32), np.array(vals))
     if len(model.must):  # Σ_k x_{f,k} ≥ 1: must operate
         spans = [np.arange(model.start[f], model.start[f + 1]) for f in model.must.tolist()]
-        ptr = np.concatenate([[0], np.cumsum([len(c) for c in spans])[:-1]]).astype(np.int32)
-        cols = np.concatenate(spans).astype(np.int32)
-        h.addRows(len(spans), np.ones(len(spans)), np.full(len(spans), inf), len(cols), ptr, cols, np.ones(len(cols)))
+        must_ptr = np.concatenate([[0], np.cumsum([len(c) for c in spans])[:-1]]).astype(np.int32)
+        must_cols = np.concatenate(spans).astype(np.int32)
+        h.addRows(len(spans), np.ones(len(spans)), np.full(len(spans), inf), len(must_cols), must_ptr, must_cols,
+                  np.ones(len(must_cols)))
     if len(model.cap_rhs):  # Σ x ≤ C: capacity
         c = len(model.cap_rhs)
         h.addRows(c, np.full(c, -inf), model.cap_rhs, len(model.cap_col), model.cap_ptr[:-1].astype(np.int32),
@@ -377,7 +380,8 @@ def _cpsat(model: GridModel, problem: SchedulingProblem, deadline: float, thread
             return EngineResult(x=None, bound=None, proved=False, termination="not run (the limit ran out building)",
                                 seconds=0.0)
     for f, group in model.prec:
-        m.add(sum(x[model.start[f]:model.start[f + 1]]) <= sum(x[j] for r in group.tolist() for j in range(model.start[r], model.start[r + 1])))
+        m.add(sum(x[model.start[f]:model.start[f + 1]])
+              <= sum(x[j] for r in group.tolist() for j in range(model.start[r], model.start[r + 1])))
     for f in model.must.tolist():
         m.add_exactly_one(x[model.start[f]:model.start[f + 1]])
     for r, cap in enumerate(model.cap_rhs.tolist()):
@@ -450,7 +454,8 @@ def run_engine(engine: str, model: GridModel, problem: SchedulingProblem, limit_
                             termination=f"highs: {first.termination}; cpsat: {second.termination}",
                             seconds=first.seconds + second.seconds, first_incumbent_s=first.first_incumbent_s,
                             best_incumbent_s=(best_t + (first.seconds if x is second.x else 0.0)) if best_t is not None else None)
-    raise UamoptError(f"unknown engine '{engine}'", "solver timeindexed", "use engine = \"auto\", \"highs\", \"cpsat\" or \"hybrid\"")
+    raise UamoptError(f"unknown engine '{engine}'", "solver timeindexed",
+                      "use engine = \"auto\", \"highs\", \"cpsat\" or \"hybrid\"")
 
 
 def _grid_is_exact(problem: SchedulingProblem, step_s: float) -> bool:
@@ -474,7 +479,7 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
         engine = "highs" if int(np.sum(np.floor(small.delay_upper_s / step) + 1)) <= AUTO_HIGHS_COLUMNS else "hybrid"
     model = build_grid_model(small, step, kind, both_ways=engine == "cpsat")
     built = time.perf_counter() - t0
-    hint = model.columns_of(start.operated, start.delay_s) if kind == "grid" and start.found else None
+    hint = model.columns_of(*start.decisions) if kind == "grid" and start.found else None
     limit = max(0.1, profile.time_limit_s - built - cont_s)
     result = run_engine(engine, model, problem, limit, profile.threads, profile.seed, gap, hint)
     extras = {"model": model_name(kind, step), "engine": engine, "termination": result.termination,
@@ -502,7 +507,7 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
         raise no_schedule(problem, profile.name or "timeindexed", f"the engine stopped ({result.termination}) with none")
     if kind == "relaxed":  # a bound only: the incumbent shown is the warm start (feasible, continuous)
         extras["incumbent"] = f"warm start ({start.source}); the relaxation's points are not schedules"
-        return make_schedule(problem, "timeindexed", "time_limit", start.operated, start.delay_s, bound=result.bound,
+        return make_schedule(problem, "timeindexed", "time_limit", *start.decisions, bound=result.bound,
                              solve_seconds=time.perf_counter() - t0, seed=profile.seed, extras=extras)
     if result.x is None:
         operated, delay = np.zeros(n, dtype=bool), np.zeros(n)
@@ -511,7 +516,7 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
     # The grid model is a restriction: "optimal" on it is not optimal for continuous delays, and its
     # bound is no bound of the continuous problem. Status optimal_on_grid; the grid bound is kept in
     # extras["restricted_bound"]; ``bound`` holds only the relaxed model's bound, when computed.
-    status = "optimal_on_grid" if result.proved else "time_limit"
+    status: Status = "optimal_on_grid" if result.proved else "time_limit"
     extras["restricted_bound"] = result.bound
     exact = _grid_is_exact(problem, step)  # every time on the grid: the grid's optimum and bound are the continuous ones
     extras["grid_exact"] = exact

@@ -36,14 +36,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from uamopt.errors import UamoptError
 from uamopt.schedule.model import (
     Schedule,
     SchedulingProblem,
+    Status,
     evaluate,
     make_schedule,
     violations,
 )
-from uamopt.errors import UamoptError
 from uamopt.solvers.greedy import DEFAULT_STEP_S, greedy_decisions
 
 
@@ -62,6 +63,12 @@ class Start:
     @property
     def found(self) -> bool:
         return self.operated is not None
+
+    @property
+    def decisions(self) -> tuple[np.ndarray, np.ndarray]:
+        """(operated, delay_s) of a start that was ``found``."""
+        assert self.operated is not None and self.delay_s is not None, "no start was found"
+        return self.operated, self.delay_s
 
 
 def _pinned(problem: SchedulingProblem, shown: int = 8) -> str:
@@ -106,7 +113,8 @@ def reduced(problem: SchedulingProblem) -> SchedulingProblem:
     fs = problem.flights
     if np.all(cap >= fs.delay_upper_s):
         return problem
-    flights = tuple(dataclasses.replace(f, max_delay_s=float(min(f.max_delay_s, c))) for f, c in zip(fs.flights, cap))
+    flights = tuple(dataclasses.replace(f, max_delay_s=float(min(f.max_delay_s, c)))
+                    for f, c in zip(fs.flights, cap, strict=True))
     return dataclasses.replace(problem, flights=dataclasses.replace(fs, flights=flights))
 
 
@@ -168,11 +176,12 @@ def no_worse(problem: SchedulingProblem, schedule: Schedule, start: Start) -> Sc
         return schedule
     extras = dict(schedule.extras, incumbent=f"warm start ({start.source}): the solver's own was "
                   f"{'none' if schedule.objective is None else f'{schedule.objective:.6f}'}")
+    status: Status
     bound, status = schedule.bound, "time_limit"
     if schedule.status in ("optimal", "optimal_on_grid"):  # optimal on a restricted model that does not hold the start
         status = "feasible"
         if schedule.bound is not None and schedule.bound > start.objective + 1e-9 * (1.0 + abs(start.objective)):
             bound = None  # not a bound of the problem the start solves
             extras["bound_dropped"] = f"{schedule.bound!r}: the optimum of {schedule.extras.get('model', 'its model')}"
-    return make_schedule(problem, schedule.solver, status, start.operated, start.delay_s, bound=bound,
+    return make_schedule(problem, schedule.solver, status, *start.decisions, bound=bound,
                          solve_seconds=schedule.solve_seconds, seed=schedule.seed, extras=extras)

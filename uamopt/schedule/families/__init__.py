@@ -49,11 +49,16 @@ SHAPES = ("pairs", "turnaround", "precedence", "bounds", "must_operate", "cumula
 
 @runtime_checkable
 class Family(Protocol):
-    """What every family provides (module docstring)."""
+    """What every family provides (module docstring); read-only, so that a frozen dataclass is one."""
 
-    name: str
-    shape: str
-    description: str
+    @property
+    def name(self) -> str: ...
+
+    @property
+    def shape(self) -> str: ...
+
+    @property
+    def description(self) -> str: ...
 
     def violations(self, problem: SchedulingProblem, operated: np.ndarray, delay_s: np.ndarray,
                    tol_s: float) -> list[str]: ...

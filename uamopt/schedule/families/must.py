@@ -21,4 +21,5 @@ class MustOperate:
 
     def violations(self, problem, operated, delay_s, tol_s) -> list[str]:
         ids = problem.flights.ids
-        return [f"flight {ids[i]}: must operate but is cancelled" for i in np.flatnonzero(self.mask & ~np.asarray(operated, bool))]
+        return [f"flight {ids[i]}: must operate but is cancelled"
+                for i in np.flatnonzero(self.mask & ~np.asarray(operated, bool))]

@@ -60,7 +60,7 @@ class Pads:
             hold = down + float(flightset.turnaround_after_s[i])
             if f.destination in where and hold > 0:
                 rows.append((i, where[f.destination], time - down, hold, True))
-        cols = list(zip(*rows)) if rows else [[], [], [], [], []]
+        cols = list(zip(*rows, strict=True)) if rows else [(), (), (), (), ()]
         return cls(resources=names, capacity=np.array([pads[n] for n in names], dtype=np.int64),
                    flight=np.array(cols[0], dtype=np.int64), resource=np.array(cols[1], dtype=np.int64),
                    offset_s=np.array(cols[2], dtype=float), duration_s=np.array(cols[3], dtype=float),
@@ -68,7 +68,7 @@ class Pads:
 
     def record(self) -> dict:
         """Every vertiport of the network: its capacity, null where unlimited."""
-        pads: dict[str, int | None] = {n: int(c) for n, c in zip(self.resources, self.capacity)}
+        pads: dict[str, int | None] = {n: int(c) for n, c in zip(self.resources, self.capacity, strict=True)}
         pads |= {n: None for n in self.unlimited}
         return {"name": self.name, "shape": self.shape, "pads": dict(sorted(pads.items()))}
 
@@ -110,7 +110,8 @@ class Pads:
         keep = self.flight[a] != self.flight[b]
         a, b = a[keep], b[keep]
         oa, la, ob, lb = self.offset_s[a], self.duration_s[a], self.offset_s[b], self.duration_s[b]
-        rows = list(zip(self.flight[a].tolist(), self.flight[b].tolist(), (oa - ob - lb).tolist(), (oa + la - ob).tolist()))
+        rows = list(zip(self.flight[a].tolist(), self.flight[b].tolist(), (oa - ob - lb).tolist(), (oa + la - ob).tolist(),
+                        strict=True))
         return PairIntervals.of_rows(self.name, rows, description="vertiport pads (one pad: no two holds overlap)")
 
     def restricted(self, pos: np.ndarray) -> Pads:
@@ -134,7 +135,7 @@ class Pads:
             ev = np.flatnonzero((self.resource == r) & c[self.flight])
             start = dep[self.flight[ev]] + self.offset_s[ev]
             end = start + self.duration_s[ev]
-            for k, t in zip(ev.tolist(), start.tolist()):  # the load is largest at some start
+            for t in start.tolist():  # the load is largest at some start
                 on = ev[(start <= t + tol_s) & (end > t + tol_s)]
                 if len(on) > self.capacity[r]:
                     who = ", ".join(ids[int(self.flight[j])] for j in on)

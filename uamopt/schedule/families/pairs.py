@@ -10,6 +10,7 @@ from one vertiport. Several pair families are merged into one pair view for the 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any, Self
 
 import numpy as np
 
@@ -35,15 +36,15 @@ class PairIntervals:
 
     @classmethod
     def of_table(cls, name: str, p, q, ptr, intervals, description: str | None = None,
-                 record_data: dict | None = None) -> PairIntervals:
+                 record_data: dict | None = None) -> Self:
         iv = np.asarray(intervals, dtype=float).reshape(-1, 2)
-        kw = {"record_data": record_data} | ({} if description is None else {"description": description})
+        kw: dict[str, Any] = {"record_data": record_data} | ({} if description is None else {"description": description})
         return cls(name=name, p=np.asarray(p, dtype=np.int64), q=np.asarray(q, dtype=np.int64),
                    ptr=np.asarray(ptr, dtype=np.int64), lo=iv[:, 0].copy(), hi=iv[:, 1].copy(), **kw)
 
     @classmethod
     def of_rows(cls, name: str, rows: list[tuple[int, int, float, float]], description: str | None = None,
-                record_data: dict | None = None) -> PairIntervals:
+                record_data: dict | None = None) -> Self:
         """From rows (a, b, lo, hi): dep_b − dep_a ∉ (lo, hi), any order of a and b (flipped to a < b)."""
         fixed = sorted((a, b, lo, hi) if a < b else (b, a, -hi, -lo) for a, b, lo, hi in rows)
         return cls.of_table(name, *compress_rows(fixed), description=description, record_data=record_data)
@@ -63,7 +64,7 @@ class PairIntervals:
                 f"({self.lo[r]:.3f}, {self.hi[r]:.3f}) ({self.name})" for r in np.flatnonzero(bad)]
 
 
-def compress_rows(rows: list[tuple[int, int, float, float]]):
+def compress_rows(rows: list[tuple[int, int, float, float]]) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Sorted rows (p, q, lo, hi) → (p, q, ptr, intervals) with each pair's intervals merged where
     they overlap (open intervals that only touch stay apart: the shared end is allowed)."""
     p_out, q_out, ptr, iv = [], [], [0], []
@@ -101,5 +102,5 @@ def merged(families) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     rows = []
     for f in families:
         row_pair = np.repeat(np.arange(len(f.p)), np.diff(f.ptr))
-        rows += list(zip(f.p[row_pair].tolist(), f.q[row_pair].tolist(), f.lo.tolist(), f.hi.tolist()))
+        rows += list(zip(f.p[row_pair].tolist(), f.q[row_pair].tolist(), f.lo.tolist(), f.hi.tolist(), strict=True))
     return compress_rows(sorted(rows))

@@ -37,11 +37,15 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from uamopt.errors import ScenarioError
 from uamopt.schedule.families.pairs import PairIntervals
+
+if TYPE_CHECKING:
+    from uamopt.schedule.model import ObjectiveKind
 
 
 @dataclass(frozen=True, eq=False)
@@ -61,6 +65,7 @@ class SpeedChoice(PairIntervals):
         None when the cruise speed is not an option."""
         if not np.any(self.factor == 1.0):
             return None
+        assert self.copy_of is not None, "speed_problem sets copy_of"
         n_copies = len(self.copy_of)
         on, d = np.zeros(n_copies, dtype=bool), np.zeros(n_copies)
         cruise = np.flatnonzero(self.factor == 1.0)  # one per flight, in flight order
@@ -82,8 +87,8 @@ def try_order(factors: tuple[float, ...]) -> tuple[float, ...]:
     return tuple(sorted(factors, key=lambda k: (k != 1.0,)))
 
 
-def speed_problem(flightset, factors, *, change_cost_s: float = 0.0, weights=(0.6, 0.4), objective: str = "lexicographic",
-                  time_step_s: float = 10.0, families_of=None):
+def speed_problem(flightset, factors, *, change_cost_s: float = 0.0, weights=(0.6, 0.4),
+                  objective: ObjectiveKind = "lexicographic", time_step_s: float = 10.0, families_of=None):
     """The scheduling model with a speed choice per flight (module docstring); ``families_of(flightset)``
     gives the extra families of a flight set (the scenario's, families.scenario_families), for the
     copies and for the cruise-speed model alike."""
@@ -96,15 +101,16 @@ def speed_problem(flightset, factors, *, change_cost_s: float = 0.0, weights=(0.
     from uamopt.schedule.occupancy import conflict_table
 
     order = try_order(check_factors(factors))
+    pair = (float(weights[0]), float(weights[1]))  # (ω6, ω7)
     base = flightset
     n, k = len(base), len(order)
-    copies, copy_of, factor = [], [], []
+    copies, copy_rows, factor_rows = [], [], []
     for i, f in enumerate(base.flights):
         for s in order:
             copies.append(dataclasses.replace(f, id=f"{f.id}@{s:g}" if s != 1.0 else f.id, speed_mps=f.speed_mps * s))
-            copy_of.append(i)
-            factor.append(s)
-    copy_of, factor = np.array(copy_of, dtype=np.int64), np.array(factor, dtype=float)
+            copy_rows.append(i)
+            factor_rows.append(s)
+    copy_of, factor = np.array(copy_rows, dtype=np.int64), np.array(factor_rows, dtype=float)
     expanded = dataclasses.replace(base, flights=tuple(copies))
     index = np.arange(n * k).reshape(n, k)  # copies of flight i: index[i]
     upper = DelayBounds.of(expanded)
@@ -115,22 +121,23 @@ def speed_problem(flightset, factors, *, change_cost_s: float = 0.0, weights=(0.
               "cruise_speed_mps": {f.id: f.speed_mps for f in base.flights}}
     choice = SpeedChoice.of_rows("speed_choice", rows, record_data=record,
                                  description="speed choice: one speed per flight (copies of a flight never both operate)")
-    plain = SchedulingProblem(flights=base, conflicts=conflict_table(base), weights=tuple(float(w) for w in weights),
+    plain = SchedulingProblem(flights=base, conflicts=conflict_table(base), weights=pair,
                               aircraft_count=base.n_aircraft, objective_kind=objective, time_step_s=time_step_s,
                               extra_families=tuple(families_of(base)))
     choice = dataclasses.replace(choice, copy_of=copy_of, factor=factor, base=base, base_problem=plain)
     dep, gap = base.planned_departure_s, base.turnaround_after_s
     time = expanded.flight_time_s
-    e_rows, f_rows = [], []
+    e_list, f_list = [], []
     for chain in base.chains:
         for x, e in enumerate(chain.tolist()):
             for f in chain[x + 1:].tolist():
                 for a in index[e]:
                     for b in index[f]:
-                        e_rows.append(a)
-                        f_rows.append(b)
-    e_rows, f_rows = np.array(e_rows, dtype=np.int64), np.array(f_rows, dtype=np.int64)
-    turn = Turnaround(e=e_rows, f=f_rows, need_s=dep[copy_of[e_rows]] + time[e_rows] + gap[copy_of[e_rows]] - dep[copy_of[f_rows]],
+                        e_list.append(a)
+                        f_list.append(b)
+    e_rows, f_rows = np.array(e_list, dtype=np.int64), np.array(f_list, dtype=np.int64)
+    turn = Turnaround(e=e_rows, f=f_rows,
+                      need_s=dep[copy_of[e_rows]] + time[e_rows] + gap[copy_of[e_rows]] - dep[copy_of[f_rows]],
                       name="speed_turnaround",
                       description="turnaround (Eqs. 27-28) at the chosen speeds: every copy pair of an aircraft's flights")
     req = base.requires
@@ -149,7 +156,7 @@ def speed_problem(flightset, factors, *, change_cost_s: float = 0.0, weights=(0.
     if np.any(change > 0):
         terms = terms.with_operate_cost(change)
     core = (upper, MustOperate(np.zeros(n * k, dtype=bool)), prec, turn, conflicts, choice)
-    return SchedulingProblem(flights=expanded, conflicts=c, weights=tuple(float(w) for w in weights),
+    return SchedulingProblem(flights=expanded, conflicts=c, weights=pair,
                              aircraft_count=base.n_aircraft, objective_kind=objective, time_step_s=time_step_s,
                              core_families=core, extra_families=tuple(families_of(expanded)), objective_terms=terms)
 

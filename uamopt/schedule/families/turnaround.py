@@ -34,13 +34,13 @@ class Turnaround:
     @classmethod
     def of(cls, flightset) -> Turnaround:
         dep, time, gap = flightset.planned_departure_s, flightset.flight_time_s, flightset.turnaround_after_s
-        e, f = [], []
+        e_rows, f_rows = [], []
         for chain in flightset.chains:
             for i in range(len(chain) - 1):
-                e.append(np.full(len(chain) - 1 - i, chain[i]))
-                f.append(chain[i + 1:])
-        e = np.concatenate(e).astype(np.int64) if e else np.zeros(0, np.int64)
-        f = np.concatenate(f).astype(np.int64) if f else np.zeros(0, np.int64)
+                e_rows.append(np.full(len(chain) - 1 - i, chain[i]))
+                f_rows.append(chain[i + 1:])
+        e = np.concatenate(e_rows).astype(np.int64) if e_rows else np.zeros(0, np.int64)
+        f = np.concatenate(f_rows).astype(np.int64) if f_rows else np.zeros(0, np.int64)
         return cls(e=e, f=f, need_s=dep[e] + time[e] + gap[e] - dep[f])
 
     def __len__(self) -> int:
