@@ -31,6 +31,7 @@ import io
 import json
 import math
 import os
+import re
 import shutil
 import signal
 import subprocess
@@ -155,7 +156,7 @@ def run_case(case: Case, code: Path) -> tuple[list[str], str]:
     if "MemoryError" in text or "Cannot allocate memory" in text or "std::bad_alloc" in text:
         faults.append("hang/memory")
     if "Traceback (most recent call last)" in text:
-        if case.signal_at is not None and ", in _main" not in text and ", in main" not in text:
+        if case.signal_at is not None and not re.search(r'uamopt/cli\.py", line \d+, in _?main', text):
             faults.append("before uamopt")  # the signal came before main() ran: Python's start, site, the imports
         else:
             faults.append("traceback")

@@ -269,6 +269,16 @@ def build_model(problem: SchedulingProblem, extra=None) -> pyo.ConcreteModel:
     return m
 
 
+def _model_status(solver) -> str:
+    """HiGHS's own model status, which Pyomo reads as ``unknown`` when it has no name for it (an
+    interrupt, a solve error): the words the error line needs to be acted on."""
+    try:
+        highs = solver._solver_model
+        return f"HiGHS model status: {highs.modelStatusToString(highs.getModelStatus())}"
+    except Exception:  # noqa: BLE001 - an interface without the highspy object: say nothing more
+        return "HiGHS model status unavailable"
+
+
 def least_delays(problem: SchedulingProblem, operated: np.ndarray, chosen: dict[int, tuple[float, float]],
                  orders: Sequence[tuple[int, int, float]] = ()) -> np.ndarray | None:
     """The least delays (minimal Σ d) of the operated flights for fixed gap choices, or None if none fit.
@@ -456,7 +466,8 @@ def solve(problem: SchedulingProblem, profile, extra=None) -> Schedule:
                 ) or (stopped and tc == TerminationCondition.unknown):  # our deadline interrupt (deadline.py)
         status = "time_limit"
     else:
-        raise UamoptError(f"HiGHS stopped with {tc.name}", f"solver {profile.name or 'highs'}", "see the HiGHS log (tee=True)")
+        raise UamoptError(f"HiGHS stopped with {tc.name} ({_model_status(solver)})", f"solver {profile.name or 'highs'}",
+                          "see the HiGHS log (tee=True)")
     operated, delay = np.zeros(n, bool), np.zeros(n)
     if has_solution:
         result.solution_loader.load_vars()
