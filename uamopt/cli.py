@@ -290,9 +290,15 @@ def main(argv: list[str] | None = None) -> int:
         # the shutdown is the interpreter's own teardown, where Python drops its handlers and a
         # signal would kill the finished command (exit -2 / -15, no line)
         atexit.register(lambda: [signal.signal(s, signal.SIG_IGN) for s in (signal.SIGINT, signal.SIGTERM)])
-    code = _main(argv)
-    if argv is None:  # the command is over
-        _exit_on_signal(code)
+    code = None
+    try:
+        code = _main(argv)
+        if argv is None:  # the command is over
+            _exit_on_signal(code)
+    except KeyboardInterrupt:  # the signal came after the command ended, before the handlers above took over
+        if code is None or argv is not None:
+            raise
+        _finish(code)
     return code
 
 
@@ -300,19 +306,25 @@ def _exit_on_signal(code: int) -> None:
     """A Ctrl-C or SIGTERM while the interpreter shuts down (waiting for library threads, their exit
     hooks: 0.5 s and more on a loaded machine) finds the command finished: exit with its code at
     once, instead of a traceback or a finished run killed by the signal with no line."""
-    import os
     import signal
 
     def finished(signum, frame) -> None:
-        for stream in (sys.stdout, sys.stderr):
-            try:
-                stream.flush()
-            except Exception:  # noqa: BLE001 - a closed or broken stream: nothing more to say
-                pass
-        os._exit(code)
+        _finish(code)
 
     for sig in (signal.SIGINT, signal.SIGTERM):
         signal.signal(sig, finished)
+
+
+def _finish(code: int) -> None:
+    """End the process now with the finished command's exit code (its output flushed)."""
+    import os
+
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.flush()
+        except Exception:  # noqa: BLE001 - a closed or broken stream: nothing more to say
+            pass
+    os._exit(code)
 
 
 def _shipped_files(args) -> None:
@@ -330,11 +342,11 @@ def _shipped_files(args) -> None:
 
 
 def _main(argv: list[str] | None) -> int:
-    from uamopt.interrupts import install_handlers, interrupt_of
+    try:  # a Ctrl-C while the handlers are installed or the command line is read: one line too
+        from uamopt.interrupts import install_handlers, interrupt_of
 
-    install_handlers()  # SIGTERM cleans up like Ctrl-C (uamopt.interrupts)
-    warnings.showwarning = _warning_line
-    try:
+        install_handlers()  # SIGTERM cleans up like Ctrl-C (uamopt.interrupts)
+        warnings.showwarning = _warning_line
         args = build_parser().parse_args(argv)
     except KeyboardInterrupt as exc:
         return _interrupted(None, exc)
