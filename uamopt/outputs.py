@@ -276,15 +276,17 @@ def staged_output(out_dir: str | Path, option: str = "--out") -> Iterator[Path]:
     """
     with output_lock(out_dir, option) as out:
         real, lock = _real(out), _held[_real(out)]
-        try:
-            stage = Path(tempfile.mkdtemp(prefix=lock.prefix + STAGE_TAG, dir=lock.site))
-        except OSError as exc:
-            raise _cannot_write(exc, lock.site, option) from None
-        umask = os.umask(0)
-        os.umask(umask)
-        stage.chmod(0o777 & ~umask)  # it may become --out itself: a folder as mkdir makes it, not mkdtemp's 0700
+        stage: Path | None = None
         staged = False
         try:
+            try:
+                with deferred_signals():  # an interrupt arriving now is raised once ``stage`` is known
+                    stage = Path(tempfile.mkdtemp(prefix=lock.prefix + STAGE_TAG, dir=lock.site))
+            except OSError as exc:
+                raise _cannot_write(exc, lock.site, option) from None
+            umask = os.umask(0)
+            os.umask(umask)
+            stage.chmod(0o777 & ~umask)  # it may become --out itself: a folder as mkdir makes it, not mkdtemp's 0700
             yield stage
             _sync_tree(stage)
             staged = True
@@ -295,9 +297,10 @@ def staged_output(out_dir: str | Path, option: str = "--out") -> Iterator[Path]:
             state = "nothing was written to it" if not staged else "it may hold some of the new files"
             raise NoSpaceError(f"cannot write the results: {exc.strerror}", str(out),
                               f"free some space or choose a folder on another disk; {state}") from None
-        finally:
-            with deferred_signals():
-                shutil.rmtree(stage, ignore_errors=True)
+        finally:  # an interrupt between mkdtemp and the block left the staging folder behind
+            if stage is not None:
+                with deferred_signals():
+                    shutil.rmtree(stage, ignore_errors=True)
 
 
 def _jsonable(value: Any) -> Any:
