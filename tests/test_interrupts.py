@@ -292,3 +292,26 @@ def test_ctrl_c_just_after_the_result_line_keeps_exit_0(tmp_path):
     # its return: wider on a loaded machine), exit 130 with the one line saying the results were complete
     assert all(code == 0 or (code == 130 and err.strip().endswith("were complete before the interrupt")
                              and "Traceback" not in err) for code, err in codes), codes
+
+
+LEAK = """import multiprocessing, os, sys
+if sys.argv[1] == "quiet":
+    from uamopt.experiments.engine import quiet_resource_tracker
+    quiet_resource_tracker()
+# what an interrupted sweep leaves: a semaphore registered with the tracker and never released
+semaphore = multiprocessing.get_context("spawn").Lock()
+sys.stderr.flush()
+os._exit(0)  # no finalizer runs, as after a stopped cluster
+"""
+
+
+@pytest.mark.parametrize("mode", ["quiet", "default"])
+def test_the_resource_tracker_cleans_up_a_leaked_semaphore_without_a_warning(mode):
+    """After a sweep's interrupt line the tracker printed "UserWarning: resource_tracker: There
+    appear to be 1 leaked semaphore objects" (2 of 9 SIGINTs 1.8-2.2 s into a sweep). The
+    ``default`` case shows the leak is real, so the ``quiet`` case can fail."""
+    proc = subprocess.run([sys.executable, "-c", LEAK, mode], cwd=ROOT, capture_output=True, text=True, check=False,
+                          timeout=60)
+    assert proc.returncode == 0, proc.stderr
+    leaked = "leaked semaphore" in proc.stderr
+    assert leaked == (mode == "default"), proc.stderr

@@ -41,6 +41,20 @@ from uamopt.optional import require
 
 CONNECT_TIMEOUT_S = 3.0
 
+# After an interrupted sweep the resource tracker (a child process multiprocessing starts beside
+# the workers) finds a semaphore the stopped cluster did not release, removes it, and says so with
+# a UserWarning on the terminal, after the interrupt's one line. The removal is its job; the
+# message is noise. The tracker is started with this process's -W options, so the filter goes
+# there, before the tracker starts.
+TRACKER_QUIET = "ignore:resource_tracker:UserWarning:multiprocessing.resource_tracker"
+
+
+def quiet_resource_tracker() -> None:
+    """Mute the resource tracker's leaked-semaphore warning in the tracker this process starts
+    next (the tracker still removes what it finds)."""
+    if TRACKER_QUIET not in sys.warnoptions:
+        sys.warnoptions.append(TRACKER_QUIET)
+
 
 def connect(scheduler: str | None, workers: int | None, tasks: int, scratch: str | None = None):
     """A Dask client: on the cluster at ``scheduler``, or on a new loopback LocalCluster whose
@@ -61,6 +75,7 @@ def connect(scheduler: str | None, workers: int | None, tasks: int, scratch: str
             raise UamoptError(f"cannot reach the Dask scheduler at {scheduler} ({error_line(exc)})", "--scheduler",
                               "start one with `dask scheduler`, check the address, or drop --scheduler") from None
     n = workers or max(1, min(os.cpu_count() or 1, tasks))
+    quiet_resource_tracker()
     # Ctrl-C reaches every process of the terminal's group, and the workers printed tracebacks.
     # Processes started while SIGINT is ignored keep ignoring it, so the workers start so; this
     # process takes Ctrl-C again once they run, and stops them (a Ctrl-C during the start is lost).
