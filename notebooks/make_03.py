@@ -68,7 +68,7 @@ QUANTITIES = {"operated": "{:.0f}", "cancelled": "{:.0f}", "total delay (s)": "{
 columns = {}
 for (quantity, fmt), i in zip(QUANTITIES.items(), range(4)):
     columns[(quantity, "paper")] = [fmt.format(PAPER_TABLE3[n][i]) if n in PAPER_TABLE3 else "" for n in schedules]
-    columns[(quantity, "uamopt")] = [fmt.format((s.operated_count, s.cancelled, s.total_delay_s, s.avg_delay_s)[i])
+    columns[(quantity, "uamopt")] = [fmt.format((s.operated_count, s.cancelled_count, s.total_delay_s, s.avg_delay_s)[i])
                                      for s in schedules.values()]
 table3 = pd.DataFrame(columns, index=pd.Index(list(schedules), name="schedule"))
 table3[("status", "uamopt")] = [s.status for s in schedules.values()]

@@ -115,7 +115,8 @@ def two_instances():
 
 def test_library_benchmark_and_performance_profile(two_instances, tmp_path, capsys):
     import uamopt as ua
-    from uamopt.experiments.bench_report import performance_ratios, write_bench
+    from uamopt.experiments.bench_report import write_bench
+    from uamopt.plotting.benchmark import performance_ratios
 
     table = ua.benchmark(two_instances, ["greedy", "highs"], seeds=[0], time_limit_s=10)
     assert table["instance"].tolist() == ["G4", "G4", "G6", "G6"] and table["flights"].tolist() == [24, 24, 36, 36]
@@ -148,7 +149,7 @@ def test_no_incumbent_has_no_objective_and_no_gap(two_instances):
 
 
 def test_progress_lines_when_not_on_a_terminal():
-    from uamopt.experiments.progress import Progress
+    from uamopt.progress import Progress
 
     stream = io.StringIO()
     with Progress(3, "bench", "solves", every=True, stream=stream) as bar:
@@ -164,7 +165,7 @@ def test_progress_bar_on_a_terminal():
     import pty
     import time
 
-    from uamopt.experiments.progress import Progress
+    from uamopt.progress import Progress
 
     master, slave = pty.openpty()
     with os.fdopen(slave, "w") as stream:

@@ -137,7 +137,7 @@ def check_against_bruteforce(lattice: bool, problem: SchedulingProblem) -> None:
     exact = milp.solve(problem, HIGHS)
     discrete = cpsat.solve(problem, CPSAT)
     event(f"conflict pairs: {len(problem.conflicts)}")
-    event(f"cancelled at the optimum: {oracle.cancelled}")
+    event(f"cancelled at the optimum: {oracle.cancelled_count}")
     event(f"delayed at the optimum: {oracle.total_delay_s > 0}")
     for schedule in (oracle, exact, discrete):
         check_feasible(problem, schedule)

@@ -20,8 +20,8 @@ from pyproj import Transformer
 from uamopt.cli import main
 from uamopt.errors import UamoptError
 from uamopt.export.frame import scenario_frame
+from uamopt.export.zone import protected_zone
 from uamopt.scenario import load_scenario
-from uamopt.sim.zone import protected_zone
 
 DT = 0.05
 FT, KT = 0.3048, 1852.0 / 3600.0
@@ -167,7 +167,7 @@ def test_export_bad_input(tmp_path, capsys):
 
 
 def test_protected_zone_from_the_cells():
-    """r_pz = r·min(Δx, Δy) − 2e_h − 0.5 m, h_pz = r·Δz − 2e_v − 0.5 m (uamopt/sim/zone.py)."""
+    """r_pz = r·min(Δx, Δy) − 2e_h − 0.5 m, h_pz = r·Δz − 2e_v − 0.5 m (uamopt/export/zone.py)."""
     zone = protected_zone((20.0, 10.0, 8.0), 2, budget_h_m=1.0, budget_v_m=0.5)
     assert (zone.rpz_m, zone.hpz_m) == (17.5, 14.5)
     assert zone.near_m == (62.0, 32.0, 25.0)  # (r + 1)Δ + 2e
@@ -179,8 +179,7 @@ def test_protected_zone_from_the_cells():
 def test_docstring_examples_run():
     import doctest
 
-    from uamopt.export import frame
-    from uamopt.sim import zone
+    from uamopt.export import frame, zone
 
     for module in (frame, zone):
         assert doctest.testmod(module).failed == 0

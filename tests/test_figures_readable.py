@@ -24,9 +24,9 @@ from matplotlib.figure import Figure
 
 from uamopt import plotting
 from uamopt.errors import UamoptError
-from uamopt.experiments.figures import plot_sweep
 from uamopt.experiments.store import columns, typed_frame
 from uamopt.planning.pareto import ParetoPoint
+from uamopt.plotting.sweeps import plot_sweep
 
 # Fig. 21 at 10 m cells (regression values of the paper case): (ω4, ω5, C_R, C_T)
 WITH_BUFFER = [(6.2e-09, 1.0, 318.8, 29.33), (0.0053, 0.9947, 304.7, 29.37), (0.0068, 0.9932, 286.4, 29.48),
@@ -361,7 +361,7 @@ def test_sweep_delay_figures_name_the_objective():
     """Figs. 22-23 and the generic sweep figure say which objective the schedules were solved under."""
     import pandas as pd
 
-    from uamopt.experiments.figures import plot_sweep
+    from uamopt.plotting.sweeps import plot_sweep
 
     rows = [{"case": f"c{i}", "schedule.flights": f, "solver": s, "seed": 0, "status": "optimal", "verified": True,
              "objective_kind": "lexicographic", "avg_delay_s": d, "operated": f, "flights": f}
@@ -377,7 +377,7 @@ def test_weights_study_spreads_a_far_point_on_a_log_axis():
     """The weights sweep (Fig. 21 from models/variants/weights.toml): ¥29-31 and one ¥124 point."""
     import pandas as pd
 
-    from uamopt.experiments.figures import plot_sweep
+    from uamopt.plotting.sweeps import plot_sweep
 
     weights = ["[0.0, 1.0]", "[0.25, 0.75]", "[0.5, 0.5]", "[1.0, 0.0]"]
     table = pd.DataFrame({"case": list("abcd"), "tracks.weights": weights, "status": "ok",

@@ -1,4 +1,4 @@
-"""Plain-line progress off a terminal (uamopt.experiments.progress.Steps): what a log, CI or a
+"""Plain-line progress off a terminal (uamopt.progress.Steps): what a log, CI or a
 notebook's subprocess sees from ``risk``, ``plan``, ``network``, ``schedule``, ``reproduce`` and
 ``replay``: nothing from a quick command, a line at least every interval from a long one, even
 while one step (a solver, the BlueSky run) runs on."""
@@ -8,7 +8,7 @@ from __future__ import annotations
 import io
 import time
 
-from uamopt.experiments.progress import Steps
+from uamopt.progress import Steps
 
 
 def test_a_quick_command_prints_nothing():

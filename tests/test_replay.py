@@ -21,9 +21,9 @@ import pytest
 from shapely.geometry import LineString
 
 from uamopt.cli import main
+from uamopt.export.zone import protected_zone
 from uamopt.schedule.verify import verify_dir
 from uamopt.sim.replay import replay
-from uamopt.sim.zone import protected_zone
 
 pytest.importorskip("bluesky", reason="the replay needs uamopt[sim] (bluesky-simulator)")
 
@@ -137,7 +137,7 @@ def test_planted_conflict_found_with_the_right_pair_and_time(planted):
 
 def test_verifier_conflicts_are_near_pairs_and_when_they_are_not_losses(planted):
     """Both planted pairs are conflicts for the verifier; the one 30 m apart vertically is a near
-    pair but no LoS: one layer apart is in the 3×3×3 zone, yet 30 m ≥ h_pz (sim/zone.py)."""
+    pair but no LoS: one layer apart is in the 3×3×3 zone, yet 30 m ≥ h_pz (export/zone.py)."""
     folder, *_, out = planted
     problems = verify_dir(folder)
     assert any("P1 (A1)" in p and "P2 (A2)" in p for p in problems)

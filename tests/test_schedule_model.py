@@ -163,7 +163,7 @@ def test_problem_and_objective(paper):
     # Table 3's initial plan: 109 operated, total delay 2401 s -> T_d = 120.05 s
     on[:11] = False
     sched = make_schedule(problem, "test", "feasible", on, np.where(on, 2401.0 / 109, 0.0))
-    assert sched.operated_count == 109 and sched.cancelled == 11
+    assert sched.operated_count == 109 and sched.cancelled_count == 11
     assert sched.avg_delay_s == pytest.approx(120.05) and sched.objective == pytest.approx(0.6 * 120.05 - 0.4 * 109)
     lex = build_problem(fs, scenario, objective="lexicographic")
     assert evaluate(lex, on, np.zeros(n)) == -109

@@ -41,7 +41,7 @@ def small_runs(cluster, tmp_path_factory) -> dict:
 
 @pytest.mark.parametrize("name", STUDIES)
 def test_small_sweep_runs_and_draws_its_figure(small_runs, name):
-    from uamopt.experiments.figures import plot_sweep
+    from uamopt.plotting.sweeps import plot_sweep
 
     table, out = small_runs[name]
     assert (table["status"] != "error").all(), table["error"].dropna().tolist()

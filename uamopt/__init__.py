@@ -54,7 +54,7 @@ _LAZY = {
     "load_flights": "uamopt.io", "load_schedule": "uamopt.io",
     # experiments: not modules of these names, so that importing one never shadows the function
     "sweep": "uamopt.experiments.engine", "load_sweep": "uamopt.experiments.spec",
-    "plot_sweep": "uamopt.experiments.figures", "benchmark": "uamopt.experiments.benchmark",
+    "plot_sweep": "uamopt.plotting.sweeps", "benchmark": "uamopt.experiments.benchmark",
 }
 
 __all__ = sorted([*_LAZY, "GridError", "InfeasibleScheduleError", "InputFileError", "NoTrackError",

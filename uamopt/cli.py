@@ -101,7 +101,7 @@ def cmd_schedule(args) -> int:
     if speed_choice_of(problem) is not None:  # one row per flight, as schedule.csv (not one per speed copy)
         problem, s = collapse(problem, s)
     print(f"{s.solver}: {s.status}, {problem.objective_kind} objective {s.objective}, operated {s.operated_count}, "
-          f"cancelled {s.cancelled}, "
+          f"cancelled {s.cancelled_count}, "
           f"total delay {s.total_delay_s:.1f} s, {s.solve_seconds:.2f} s -> {Path(args.out) / 'schedule.csv'}")
     if problems:  # a solver bug, never bad input: say so loudly
         sys.stderr.write(f"error: the schedule failed verification ({len(problems)} violations, {args.out}): "
@@ -236,8 +236,8 @@ def build_parser() -> argparse.ArgumentParser:
     view.add_argument("--no-city", action="store_true", help="leave out the buildings and the unsafe airspace")
     view.set_defaults(func=cmd_view)
     command("reproduce", cmd_reproduce, "run every stage that applies and write report.md with figures", "out/reproduce")
+    from uamopt.cli_export import add_export_commands
     from uamopt.experiments.commands import add_sweep_command
-    from uamopt.export.cli import add_export_commands
 
     add_sweep_command(sub)
     add_export_commands(sub)  # export bluesky | geojson, replay

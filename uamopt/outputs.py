@@ -50,7 +50,7 @@ except ImportError:  # not POSIX (Windows): staging and the atomic move work, th
 LOCK_SUFFIX = ".uamopt.lock"
 STAGE_TAG = ".uamopt-stage-"
 PAUSE_ENV = "UAMOPT_TEST_PAUSE_IN_MOVE"
-_NO_SPACE = {errno.ENOSPC, errno.EDQUOT, errno.EFBIG}  # disk full, quota, file size limit
+NO_SPACE = {errno.ENOSPC, errno.EDQUOT, errno.EFBIG}  # disk full, quota, file size limit
 
 
 @dataclass(frozen=True)
@@ -292,7 +292,7 @@ def staged_output(out_dir: str | Path, option: str = "--out") -> Iterator[Path]:
             staged = True
             _publish(stage, real, option)
         except OSError as exc:
-            if exc.errno not in _NO_SPACE:
+            if exc.errno not in NO_SPACE:
                 raise
             state = "nothing was written to it" if not staged else "it may hold some of the new files"
             raise NoSpaceError(f"cannot write the results: {exc.strerror}", str(out),
@@ -322,3 +322,96 @@ def _jsonable(value: Any) -> Any:
 def write_json(path: str | Path, data: Any) -> None:
     """Write ``data`` as indented JSON (numpy values converted, NaN/inf as null)."""
     Path(path).write_text(json.dumps(_jsonable(data), indent=2, ensure_ascii=False) + "\n", encoding="utf-8")
+
+
+def size_text(n: float) -> str:
+    """A size in bytes as ``812 B``, ``16.2 KB``, ``3.1 MB``, ``1.5 GB`` (powers of 1024)."""
+    for unit in ("B", "KB", "MB", "GB"):
+        if n < 1024 or unit == "GB":
+            return f"{n:.0f} {unit}" if unit == "B" else f"{n:.1f} {unit}"
+        n /= 1024
+    raise AssertionError  # unreachable
+
+
+def out_of_space(exc: OSError, path: Path, size: int, need: int | None = None, where: str = "", keep: str = "",
+                 exact: bool = True) -> NoSpaceError:
+    """The one-line error of a write to ``path`` (``size`` bytes; ``exact`` False: the bytes
+    written when it stopped) that a full disk, a quota or a file-size limit stopped; ``need``: the
+    bytes still to write, this file included; ``keep``: what the user keeps (the end of the fix)."""
+    where = where or str(path.parent)
+    keep = keep or f"then run the command again ({path.name} was not written)"
+    if exc.errno == errno.EFBIG:
+        import resource
+
+        soft = resource.getrlimit(resource.RLIMIT_FSIZE)[0]
+        limit = (f"more than the file size limit of {size_text(soft)} (ulimit -f)" if soft != resource.RLIM_INFINITY
+                 else "more than the file system's largest file")
+        return NoSpaceError(f"cannot write {path}: File too large: it needs {'' if exact else 'more than '}{size_text(size)}, "
+                           f"{limit}", where,
+                           f"raise the limit (ulimit -f) or write to another disk, {keep}")
+    try:
+        free = f"{size_text(shutil.disk_usage(path.parent).free)} free"
+    except OSError:
+        free = "free space unknown"
+    need = max(need or 0, size)
+    amount = f"about {size_text(need)}" if exact or need > size else f"more than {size_text(size)}"
+    return NoSpaceError(f"cannot write {path}: {exc.strerror or 'No space left on device'}: needs {amount} to finish, {free}",
+                       where,
+                       f"free some space or write to another disk, {keep}")
+
+
+def atomic_write(path: Path, write, need: int | None = None, where: str = "", keep: str = "") -> None:
+    """Write ``write`` (bytes, or a callable ``write(tmp_path)``) to a temporary file beside
+    ``path``, flush it to disk and rename it over ``path``.
+
+    Raises
+    ------
+    UamoptError
+        The disk is full or the file too large (:func:`out_of_space`; ``need``, ``where`` and
+        ``keep`` go into its message); the temporary file is removed and ``path`` is as it was.
+    """
+    data = bytes(write) if isinstance(write, (bytes, bytearray, memoryview)) else None
+    tmp = None
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+        os.close(fd)
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)  # mkstemp's 0600 would make results private
+        if data is not None:
+            with open(tmp, "wb") as fh:
+                fh.write(data)
+                fh.flush()
+                os.fsync(fh.fileno())
+        else:
+            write(Path(tmp))
+            with open(tmp, "rb+") as fh:
+                os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    except OSError as exc:
+        size = len(data) if data is not None else file_size(tmp)
+        if tmp is not None:
+            Path(tmp).unlink(missing_ok=True)
+        if exc.errno in NO_SPACE:
+            raise out_of_space(exc, path, size, need, where, keep, exact=data is not None) from None
+        raise
+    except BaseException:
+        if tmp is not None:
+            Path(tmp).unlink(missing_ok=True)
+        raise
+    try:  # make the rename itself durable
+        dfd = os.open(path.parent, os.O_RDONLY)
+        try:
+            os.fsync(dfd)
+        finally:
+            os.close(dfd)
+    except OSError:
+        pass
+
+
+def file_size(path) -> int:
+    """The size of the file at ``path`` in bytes; 0 when there is none (or ``path`` is None)."""
+    try:
+        return os.stat(path).st_size if path is not None else 0
+    except OSError:
+        return 0

@@ -156,6 +156,54 @@ def build_problem(flights: FlightSet, scenario: Scenario | None = None, *, objec
     return build(flights, scenario, weights=weights, objective=kind)  # type: ignore[arg-type]
 
 
+def checked_network(scenario: Scenario, network_file):
+    """``--network``: the file's routes, each inside the grid, airborne and clear of the city's
+    buildings (uamopt/schedule/airspace.py), before anything is generated or written."""
+    import math
+
+    from uamopt.io import load_network
+
+    network = load_network(network_file)
+    cell = network.cell if all(math.isfinite(c) for c in network.cell) else scenario.grid.cell
+    _check_file_tracks(scenario, scenario_grid(scenario).extent, network.waypoints(), cell, f"--network {network_file}",
+                       "route")
+    return network
+
+
+def _check_file_tracks(scenario: Scenario, extent, tracks, cell, source: str, kind: str) -> None:
+    """Tracks from a file inside the airspace, then (unless ``network.tracks = "straight"``) above
+    the city's surface on the file's own cells (uamopt/schedule/airspace.py)."""
+    from uamopt.city import load_city
+    from uamopt.grid.grid import file_grid
+    from uamopt.schedule.airspace import check_above_surface, check_in_airspace
+
+    check_in_airspace(extent, tracks, source, kind)
+    if scenario.network.tracks == "straight":
+        return
+    grid = file_grid(tuple(extent), tuple(cell), scenario.grid.memory_limit_gb, source)
+    check_above_surface(tracks, load_city(scenario, grid).surface_height, grid.cell, source, kind)
+
+
+def scenario_flights(scenario: Scenario, flights_file=None, network_file=None, seed: int | None = None):
+    """The flights to schedule: ``flights_file`` (self-contained, or on ``network_file``'s routes),
+    else the generated plan on ``network_file`` or on the network planned now. Tracks from files
+    are checked against the scenario's grid and city first (uamopt/schedule/airspace.py)."""
+    from uamopt.io import load_flights
+
+    if not (flights_file or network_file):
+        scenario.network.route_list()  # a network without routes is refused before anything is computed
+    network = checked_network(scenario, network_file) if network_file else None
+    if flights_file:
+        grid = scenario_grid(scenario)
+        flights = load_flights(flights_file, scenario, grid, network and network.waypoints())
+        _check_file_tracks(scenario, grid.extent, {f.id: f.waypoints for f in flights.flights}, flights.cell,
+                           str(flights_file), "flight")
+        return flights
+    if network is None:
+        network = plan_network(planning_model(scenario, compute_risk(scenario)))
+    return generate_flights(scenario, network, seed)
+
+
 def solver_profile(profile: SolverProfile | str | Path, **overrides) -> SolverProfile:
     """A profile by name (``highs``), path or object, with ``time_limit_s``, ``seed``,
     ``threads`` or ``options`` replaced."""

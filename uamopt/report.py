@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from uamopt.paper import TABLE2, TABLE3, table4_row
 from uamopt.risk import (
     crash_area,
     drag_constant,
@@ -99,16 +100,6 @@ def write_report(path, scenario: Scenario, sections: list[str]) -> None:
     path.write_text("\n".join(head) + "\n".join(sections), encoding="utf-8")
 
 
-# Table 2 of the paper (P_O -> P_D): shortest, initial, equivalent, optimal.
-PAPER_TABLE2 = {
-    "operational risk": (196, 174, 174, 181),
-    "transport cost (¥)": (27.1527, 32.7379, 32.0715, 30.8265),
-    "waypoints": (386, 456, 453, 432),
-    "computational time (s)": (68.71, 90.58, 101.96, 108.97),
-}
-PAPER_TABLE4 = {10.0: (196, 27.1527, 386, 68.71), 5.0: (163.33, 25.7975, 636, 659.52)}
-
-
 def _change(value: float, base: float) -> str:
     return f" ({100 * (value - base) / base:+.1f} %)" if base else ""
 
@@ -171,7 +162,7 @@ def table2_section(scenario: Scenario, model, tracks: dict, title: str = "Track 
     the shape checks: each stage in its layer, Δcost and Δrisk against the shortest track."""
     st = tracks["stages"]
     names = ("shortest", "initial", "equivalent", "optimal")
-    ref = PAPER_TABLE2 if paper else {}
+    ref = TABLE2 if paper else {}
     rows = [
         ("operational risk C_R (Eq. 11)", [st[n]["risk_cost"] for n in names], ref.get("operational risk"), ".1f", True),
         ("safety-buffer exposure Σ μ·R(t) (Eq. 34)", [st[n]["buffer_cost"] for n in names], None, ".0f", False),
@@ -263,7 +254,7 @@ def table4_section(scenario: Scenario, results: list, paper: bool = True) -> str
     ]
     for side, plan, seconds in results:
         o = plan.stages["optimal"]
-        p = PAPER_TABLE4.get(float(side)) if paper else None
+        p = table4_row(side) if paper else None
         ref = (lambda i, p=p: f" [{p[i]:g}]") if p else (lambda i: "")
         lines.append(f"| {side:g} m | {o.risk_cost:.1f}{ref(0)} | {o.transport_cost:.4f}{ref(1)} | {o.n_waypoints}{ref(2)} | "
                      f"{o.length_m:.0f} | {seconds:.2f}{ref(3)} |")
@@ -321,10 +312,6 @@ def is_paper_schedule(scenario: Scenario, problem) -> bool:
     return ports == paper_ports and problem.n_flights == 120 and problem.aircraft_count == 20
 
 
-# Table 3 of the paper (operated, cancelled, total delay s)
-PAPER_TABLE3 = {"greedy": (109, 11, 2401), "soa": (117, 3, 1911), "ga": (114, 6, 2161)}
-
-
 def objective_label(problem) -> str:
     """The objective in words, as every scheduling table and figure names it."""
     if problem.objective_kind == "lexicographic":
@@ -352,11 +339,11 @@ def table3_section(problem, schedules: dict, verified: dict, suffix: str = "", p
         "|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for name, s in schedules.items():
-        p = PAPER_TABLE3.get(name) if paper else None
+        p = TABLE3.get(name) if paper else None
         ref = (lambda i, p=p: f" [{p[i]:g}]") if p else (lambda i: "")
         dist = "-" if best is None or s.objective is None else f"{s.objective - best:+.4f}"
         bound = "-" if s.bound is None else f"{s.bound:.4f}"
-        lines.append(f"| {name} | {s.status} | {s.operated_count}{ref(0)} | {s.cancelled}{ref(1)} | "
+        lines.append(f"| {name} | {s.status} | {s.operated_count}{ref(0)} | {s.cancelled_count}{ref(1)} | "
                      f"{s.total_delay_s:.1f}{ref(2)} | {s.avg_delay_s:.2f} | {s.objective:.4f} | {bound} | {dist} | "
                      f"{s.solve_seconds:.2f} | {'yes' if verified.get(name) else 'NO'} |")
     if problem.objective_kind == "weighted":

@@ -430,16 +430,23 @@ class Scenario(_Section):
     tracks: TracksConfig = TracksConfig()
     schedule: ScheduleConfig = ScheduleConfig()
 
-    @model_validator(mode="after")
-    def _random_vertiports(self) -> Scenario:
-        n = self.network.random_vertiports
+    @model_validator(mode="wrap")
+    @classmethod
+    def _random_vertiports(cls, data: Any, handler) -> Scenario:
+        """``network.random_vertiports``: the scenario as given is validated, then the whole of it
+        again with the vertiports drawn in ``grid.extent`` (routes: every pair). A new model from
+        data, so no frozen model is ever edited."""
+        scenario = handler(data)
+        n = scenario.network.random_vertiports
         if n is None:
-            return self
-        if self.grid.extent is None:
+            return scenario
+        if scenario.grid.extent is None:
             raise ValueError("network.random_vertiports needs grid.extent (the domain the vertiports are drawn in)")
-        ports = random_vertiports(n, (self.grid.extent[0], self.grid.extent[1]), seed=self.network.vertiport_seed)
-        object.__setattr__(self, "network", self.network.model_copy(update={"vertiports": ports, "routes": None}))
-        return self
+        ports = random_vertiports(n, (scenario.grid.extent[0], scenario.grid.extent[1]),
+                                  seed=scenario.network.vertiport_seed)
+        raw = scenario.model_dump(mode="python")
+        raw["network"] |= {"vertiports": [p.model_dump(mode="python") for p in ports], "routes": None}
+        return handler(raw)
 
     _base_dir: Path = PrivateAttr(default_factory=Path.cwd)
     _source: str = PrivateAttr(default="<defaults>")

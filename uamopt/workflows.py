@@ -14,8 +14,8 @@ from uamopt.scenario import Scenario
 
 def progress(total: int, desc: str):
     """A progress bar on a terminal; elsewhere plain lines once the work has run 5 s
-    (:class:`uamopt.experiments.progress.Steps`)."""
-    from uamopt.experiments.progress import Steps
+    (:class:`uamopt.progress.Steps`)."""
+    from uamopt.progress import Steps
 
     return Steps(total, desc)
 
@@ -95,47 +95,10 @@ def network_folder(scenario: Scenario, out: str | Path, figures: bool = True):
     return network
 
 
-def checked_network(scenario: Scenario, network_file):
-    """``--network``: the file's routes, each inside the grid, airborne and clear of the city's
-    buildings (uamopt/schedule/airspace.py), before anything is generated or written."""
-    import math
-
-    from uamopt.io import load_network
-    from uamopt.pipeline import scenario_grid
-    from uamopt.schedule.airspace import check_tracks
-
-    network = load_network(network_file)
-    cell = network.cell if all(math.isfinite(c) for c in network.cell) else scenario.grid.cell
-    check_tracks(scenario, scenario_grid(scenario).extent, network.waypoints(), cell, f"--network {network_file}", "route")
-    return network
-
-
-def scenario_flights(scenario: Scenario, flights_file=None, network_file=None, seed: int | None = None):
-    """The flights to schedule: ``flights_file`` (self-contained, or on ``network_file``'s routes),
-    else the generated plan on ``network_file`` or on the network planned now. Tracks from files
-    are checked against the scenario's grid and city first (uamopt/schedule/airspace.py)."""
-    from uamopt.io import load_flights
-    from uamopt.pipeline import compute_risk, generate_flights, plan_network, planning_model, scenario_grid
-    from uamopt.schedule.airspace import check_tracks
-
-    if not (flights_file or network_file):
-        scenario.network.route_list()  # a network without routes is refused before anything is computed
-    network = checked_network(scenario, network_file) if network_file else None
-    if flights_file:
-        grid = scenario_grid(scenario)
-        flights = load_flights(flights_file, scenario, grid, network and network.waypoints())
-        check_tracks(scenario, grid.extent, {f.id: f.waypoints for f in flights.flights}, flights.cell, str(flights_file),
-                     "flight")
-        return flights
-    if network is None:
-        network = plan_network(planning_model(scenario, compute_risk(scenario)))
-    return generate_flights(scenario, network, seed)
-
-
 def flights_folder(scenario: Scenario, out: str | Path, seed: int | None = None):
     """``uamopt flights``: the generated plan as a self-contained flights.json (instance generator)."""
     from uamopt.outputs import check_out_dir, staged_output, write_json
-    from uamopt.pipeline import build_problem
+    from uamopt.pipeline import build_problem, scenario_flights
     from uamopt.schedule import save_flights
 
     check_out_dir(out)
@@ -159,7 +122,7 @@ def schedule_folder(scenario: Scenario, out: str | Path, profile, flights_file=N
     (problem, schedule, violations found by the independent verifier in the written folder)."""
     from uamopt.export.frame import schedule_provenance
     from uamopt.outputs import output_lock
-    from uamopt.pipeline import build_problem, scenario_grid, solve
+    from uamopt.pipeline import build_problem, scenario_flights, scenario_grid, solve
     from uamopt.schedule import write_schedule
     from uamopt.schedule.verify import verify_dir
     from uamopt.solvers import load_profile

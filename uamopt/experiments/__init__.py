@@ -1,9 +1,9 @@
 """Experiments: resumable sweeps over scenario keys on Dask, solver benchmarks, their figures.
 
 Public names (``import uamopt as ua``): ``ua.sweep`` (engine.py), ``ua.load_sweep`` (spec.py),
-``ua.plot_sweep`` (figures.py), ``ua.benchmark`` (benchmark.py). Modules: spec.py (sweep files),
+``ua.benchmark`` (benchmark.py); the figures are in :mod:`uamopt.plotting` (``ua.plot_sweep``:
+plotting/sweeps.py, the performance profile: plotting/benchmark.py). Modules: spec.py (sweep files),
 case.py (one case on the pipeline), store.py (the results folder), engine.py (Dask, the ``sweep``
-command), figures.py (Sec. 6.3 figures), benchmark.py and bench_report.py (``uamopt bench``,
-bench.md, the performance profile), progress.py. Heavy imports (Dask, pandas, matplotlib) happen
-inside the functions.
+command), commands.py (its arguments), benchmark.py and bench_report.py (``uamopt bench``,
+bench.md). Heavy imports (Dask, pandas, matplotlib) happen inside the functions.
 """

@@ -23,7 +23,7 @@ from pathlib import Path
 
 from uamopt.errors import UamoptError
 from uamopt.experiments.case import error_line, schedule_row, scheduling_problem
-from uamopt.experiments.progress import Progress
+from uamopt.progress import Progress
 
 COLUMNS = ["instance", "flights", "aircraft", "conflicting_pairs", "solver", "profile", "seed", "threads", "time_limit_s",
            "objective_kind", "status", "model", "objective", "bound", "gap", "operated", "cancelled", "total_delay_s",
@@ -219,8 +219,8 @@ def is_airland(path) -> bool:
 
 def _cli_problem(scenario, args):
     """--flights (self-contained or on --network routes), else the generated plan (--seed)."""
+    from uamopt.pipeline import checked_network, scenario_flights
     from uamopt.schedule import build_problem
-    from uamopt.workflows import checked_network, scenario_flights
 
     seed = 0 if args.seed is None else args.seed - scenario.schedule.plan_seed
     if not args.flights:

@@ -41,7 +41,7 @@ def _unless_out_of_space(exc: Exception) -> None:
     raw OSError with that errno): the machine's state, not the case's result. The sweep then stops
     in one line with the cases saved before it, and a resume runs this case again (never a row)."""
     from uamopt.errors import NoSpaceError
-    from uamopt.experiments.store import NO_SPACE
+    from uamopt.outputs import NO_SPACE
 
     if isinstance(exc, NoSpaceError):
         raise exc
@@ -80,7 +80,7 @@ def schedule_row(problem, schedule, seconds: float) -> dict:
         gap = abs(objective - bound) / abs(objective)
     return {"status": schedule.status, "model": schedule.extras.get("model_kind"),
             "objective_kind": problem.objective_kind, "objective": objective, "bound": bound, "gap": gap,
-            "operated": schedule.operated_count, "cancelled": schedule.cancelled,
+            "operated": schedule.operated_count, "cancelled": schedule.cancelled_count,
             "total_delay_s": schedule.total_delay_s, "avg_delay_s": schedule.avg_delay_s,
             "verified": schedule.status != "infeasible" and verify(problem, schedule).ok,  # infeasible: no schedule
             "seconds": seconds}

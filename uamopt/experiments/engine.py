@@ -28,7 +28,6 @@ from pathlib import Path
 from uamopt.checks import expect_path
 from uamopt.errors import UamoptError
 from uamopt.experiments.case import error_line, run_case
-from uamopt.experiments.progress import Progress
 from uamopt.experiments.spec import SweepSpec, load_sweep, toml_value
 from uamopt.experiments.store import (
     ResultsFolder,
@@ -38,6 +37,7 @@ from uamopt.experiments.store import (
     version,
 )
 from uamopt.optional import require
+from uamopt.progress import Progress
 
 CONNECT_TIMEOUT_S = 3.0
 
@@ -270,7 +270,7 @@ def _sweep(spec: SweepSpec, folder: ResultsFolder, scheduler, workers):
     table = results_table(spec, [folder.read_parts(spec.stage)[0], *unsaved])
     folder.write_results(table)
     if spec.figure:
-        from uamopt.experiments.figures import save_sweep_figure
+        from uamopt.plotting.sweeps import save_sweep_figure
 
         save_sweep_figure(table, spec, folder.out / "figure.png")
     table.attrs.update(stats | {"unsaved": len(unsaved), "out": str(folder.out)})

@@ -369,7 +369,7 @@ def load_sweep(path: str | Path, small: bool = False) -> SweepSpec:
     _check_size(grid, limit, max(1, len(solvers) * len(seeds)), where)
     figure = raw.get("figure")
     if figure is not None:
-        from uamopt.experiments.figures import KEYS
+        from uamopt.plotting.sweeps import KEYS
 
         if figure not in KEYS:
             raise ScenarioError(f"unknown figure {figure!r}", where, f"use one of {', '.join(KEYS)}, or remove it")

@@ -28,17 +28,15 @@ temporary file is removed, every file written before it is kept.
 
 from __future__ import annotations
 
-import errno
 import hashlib
 import json
 import os
 import re
-import shutil
-import tempfile
 import warnings
 from pathlib import Path
 
-from uamopt.errors import NoSpaceError, UamoptError
+from uamopt.errors import UamoptError
+from uamopt.outputs import NO_SPACE, atomic_write, file_size, out_of_space, size_text
 
 MANIFEST = "sweep.json"
 PARTS = "parts"
@@ -59,7 +57,6 @@ KEYS = ("case", "solver", "seed", "status")
 SET_ASIDE = ".set-aside"
 PART_NAME = re.compile(r"([0-9a-f]{12})-[0-9a-f]{8}\.parquet")
 MANIFEST_MAX_BYTES = 16 * 2**20
-NO_SPACE = {errno.ENOSPC, errno.EDQUOT, errno.EFBIG}  # disk full, quota, file size limit
 COUNTS = ("operated", "cancelled", "flights", "aircraft", "conflicting_pairs", "n_waypoints")
 SHARES = ("unsafe_share", "band_unsafe_share", "cruise_unsafe_share")
 NOT_NEGATIVE = ("seconds", "gap", "length_m", "cruise_mean_risk")
@@ -99,101 +96,9 @@ def version() -> str:
 
         return _v("uamopt")
     except Exception:  # noqa: BLE001 - not installed as a distribution
-        import uamopt
+        from uamopt import __version__
 
-        return uamopt.__version__
-
-
-def size_text(n: float) -> str:
-    """A size in bytes as ``812 B``, ``16.2 KB``, ``3.1 MB``, ``1.5 GB`` (powers of 1024)."""
-    for unit in ("B", "KB", "MB", "GB"):
-        if n < 1024 or unit == "GB":
-            return f"{n:.0f} {unit}" if unit == "B" else f"{n:.1f} {unit}"
-        n /= 1024
-    raise AssertionError  # unreachable
-
-
-def out_of_space(exc: OSError, path: Path, size: int, need: int | None = None, where: str = "", keep: str = "",
-                 exact: bool = True) -> NoSpaceError:
-    """The one-line error of a write to ``path`` (``size`` bytes; ``exact`` False: the bytes
-    written when it stopped) that a full disk, a quota or a file-size limit stopped; ``need``: the
-    bytes still to write, this file included; ``keep``: what the user keeps (the end of the fix)."""
-    where = where or str(path.parent)
-    keep = keep or f"then run the command again ({path.name} was not written)"
-    if exc.errno == errno.EFBIG:
-        import resource
-
-        soft = resource.getrlimit(resource.RLIMIT_FSIZE)[0]
-        limit = (f"more than the file size limit of {size_text(soft)} (ulimit -f)" if soft != resource.RLIM_INFINITY
-                 else "more than the file system's largest file")
-        return NoSpaceError(f"cannot write {path}: File too large: it needs {'' if exact else 'more than '}{size_text(size)}, "
-                           f"{limit}", where,
-                           f"raise the limit (ulimit -f) or write to another disk, {keep}")
-    try:
-        free = f"{size_text(shutil.disk_usage(path.parent).free)} free"
-    except OSError:
-        free = "free space unknown"
-    need = max(need or 0, size)
-    amount = f"about {size_text(need)}" if exact or need > size else f"more than {size_text(size)}"
-    return NoSpaceError(f"cannot write {path}: {exc.strerror or 'No space left on device'}: needs {amount} to finish, {free}",
-                       where,
-                       f"free some space or write to another disk, {keep}")
-
-
-def atomic_write(path: Path, write, need: int | None = None, where: str = "", keep: str = "") -> None:
-    """Write ``write`` (bytes, or a callable ``write(tmp_path)``) to a temporary file beside
-    ``path``, flush it to disk and rename it over ``path``.
-
-    Raises
-    ------
-    UamoptError
-        The disk is full or the file too large (:func:`out_of_space`; ``need``, ``where`` and
-        ``keep`` go into its message); the temporary file is removed and ``path`` is as it was.
-    """
-    data = bytes(write) if isinstance(write, (bytes, bytearray, memoryview)) else None
-    tmp = None
-    try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-        os.close(fd)
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)  # mkstemp's 0600 would make results private
-        if data is not None:
-            with open(tmp, "wb") as fh:
-                fh.write(data)
-                fh.flush()
-                os.fsync(fh.fileno())
-        else:
-            write(Path(tmp))
-            with open(tmp, "rb+") as fh:
-                os.fsync(fh.fileno())
-        os.replace(tmp, path)
-    except OSError as exc:
-        size = len(data) if data is not None else _size_of(tmp)
-        if tmp is not None:
-            Path(tmp).unlink(missing_ok=True)
-        if exc.errno in NO_SPACE:
-            raise out_of_space(exc, path, size, need, where, keep, exact=data is not None) from None
-        raise
-    except BaseException:
-        if tmp is not None:
-            Path(tmp).unlink(missing_ok=True)
-        raise
-    try:  # make the rename itself durable
-        dfd = os.open(path.parent, os.O_RDONLY)
-        try:
-            os.fsync(dfd)
-        finally:
-            os.close(dfd)
-    except OSError:
-        pass
-
-
-def _size_of(path) -> int:
-    try:
-        return os.stat(path).st_size if path is not None else 0
-    except OSError:
-        return 0
+        return __version__
 
 
 def _column_problem(series, dtype: str) -> str | None:
@@ -444,7 +349,7 @@ class ResultsFolder:
         return moved
 
     def _parts_bytes(self) -> int:
-        return sum(_size_of(p) for p in self.parts.glob("*.parquet"))
+        return sum(file_size(p) for p in self.parts.glob("*.parquet"))
 
     def _keep(self) -> str:
         """The end of a full disk's fix: what is kept, what a re-run does."""

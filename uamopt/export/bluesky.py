@@ -27,7 +27,7 @@ Faithful to the plan, within what the simulator can do (measured figures in docs
   25 m/s; BlueSky's 25° gives 137 m). Points are fly-by, VNAV with top-of-climb/descent logic
   off, so climbs follow the planned gradient.
 - Detection: ``CDMETHOD STATEBASED``, resolution off, protected zone (``ZONER``, ``ZONEDH``) from
-  the replay's zone (see :func:`uamopt.sim.zone.protected_zone`).
+  the replay's zone (see :func:`uamopt.export.zone.protected_zone`).
 - Vertical phases (the vertiport variant: a flight with ``vertical_rate_mps``, first and last
   segments vertical): the aircraft is created on its vertiport's pad at the departure, hovering
   (speed 0), and climbs with ``ALT`` at the vertical rate; its cruise (the segments between, designed
@@ -268,14 +268,14 @@ def export_bluesky(path: str | Path, zone_m: tuple[float, float] | None = None, 
                    bank_deg: float = DEFAULT_BANK_DEG, trajectory: str = DEFAULT_TRAJECTORY) -> Path:
     """Write ``DIR/bluesky.scn`` for the schedule folder ``path``; returns the file's path.
 
-    ``zone_m`` defaults to :func:`uamopt.sim.zone.protected_zone` of the folder's cell and r.
+    ``zone_m`` defaults to :func:`uamopt.export.zone.protected_zone` of the folder's cell and r.
 
     Raises
     ------
     InputFileError
         The folder or one of its files is missing or malformed.
     """
-    from uamopt.sim.zone import protected_zone
+    from uamopt.export.zone import protected_zone
 
     folder = read_schedule_folder(path)
     if zone_m is None:

@@ -34,13 +34,13 @@ it. The submodules ``risk``, ``tracks``, ``network`` and ``schedule`` are shadow
 helpers are public in :mod:`uamopt.plotting.style` and :mod:`uamopt.plotting.geometry`.
 """
 
-from uamopt.experiments.bench_report import plot_performance_profile as performance_profile
-from uamopt.experiments.figures import plot_sweep as sweep
+from uamopt.plotting.benchmark import plot_performance_profile as performance_profile
 from uamopt.plotting.explore import explore
 from uamopt.plotting.network import network
 from uamopt.plotting.risk import risk, risk_components
 from uamopt.plotting.schedule import delays, gantt
 from uamopt.plotting.style import DPI, save, show_figures_in
+from uamopt.plotting.sweeps import plot_sweep as sweep
 from uamopt.plotting.tracks import pareto, tracks
 
 

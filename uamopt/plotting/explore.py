@@ -76,7 +76,7 @@ class Explorer:
 
     def save(self, path: str | Path) -> Path:
         """Write the view as one self-contained HTML file (plotly.js inlined: no network needed)."""
-        from uamopt.experiments.store import atomic_write
+        from uamopt.outputs import atomic_write
 
         path = Path(path)
         text = self._html(True).replace("<head>", f"<head><title>{html.escape(self.title)}</title>", 1)

@@ -68,7 +68,7 @@ def gantt(problem, schedule, ax=None, *, title: str = "") -> Figure:
     delay = np.asarray(schedule.delay_s, dtype=float)
     on = np.asarray(schedule.operated, dtype=bool)
     y = np.array([row[f.aircraft] for f in flights], dtype=float)
-    default = (f"{schedule.solver}: {schedule.operated_count} operated, {schedule.cancelled} cancelled, "
+    default = (f"{schedule.solver}: {schedule.operated_count} operated, {schedule.cancelled_count} cancelled, "
                f"total delay {schedule.total_delay_s:.0f} s")
     fig, ax, _ = single_axes(ax, (14.0, max(4.0, 0.32 * len(aircraft) + 1.5)))
     ax.barh(y[on], duration[on], left=(planned + delay)[on], height=0.6,
@@ -124,7 +124,7 @@ def delays(problem, schedules: Mapping, ax=None, *, title: str = "") -> Figure:
         x = np.arange(len(idx)) + (n - (len(schedules) - 1) / 2) * width
         on = s.operated[idx]
         ax.bar(x[on], s.delay_s[idx][on], width=width, color=cmap(n),
-               label=f"{name}: total {s.total_delay_s:.0f} s, {s.cancelled} cancelled")
+               label=f"{name}: total {s.total_delay_s:.0f} s, {s.cancelled_count} cancelled")
         ax.bar(x[~on], problem.delay_upper_s[idx][~on], width=width, fill=False, edgecolor=cmap(n), hatch="..")
     ax.set_xticks(np.arange(len(idx)), [ids[i] for i in idx], rotation=90, fontsize=6)
     ax.set_ylabel("delay d (s); hollow: cancelled (drawn at Δd)")

@@ -12,20 +12,17 @@ untrusted input. Before anything is scheduled each one must
 
 The surface is the city source on the columns of the file's own cells, each column at its highest
 point, the rule by which the planner marks obstacle cells (uamopt/risk.py), so a track planned on
-those cells never fails; a track through a 239 m tower at 120 m does.
+those cells never fails; a track through a 239 m tower at 120 m does. The city itself is built by
+the caller (:func:`uamopt.pipeline.scenario_flights`): the schedule stage only checks.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import TYPE_CHECKING
 
 import numpy as np
 
 from uamopt.errors import InputFileError
-
-if TYPE_CHECKING:
-    from uamopt.scenario import Scenario
 
 TOL_M = 1e-6  # slack for coordinates on the grid's faces, m
 SAMPLES_PER_CELL = 4  # surface samples per cell side along a segment
@@ -41,20 +38,23 @@ def _points(waypoints: np.ndarray, cell: tuple[float, float, float]) -> np.ndarr
     return np.vstack([a[seg] + u[:, None] * (b - a)[seg], waypoints[-1:]])
 
 
-def check_tracks(scenario: Scenario, extent, tracks: Mapping[str, np.ndarray], cell, source: str,
-                 kind: str = "route") -> None:
-    """Refuse a track outside the grid, at or below the ground, or inside a building (module docstring).
+def _unique(tracks: Mapping[str, np.ndarray]) -> list[tuple[str, np.ndarray]]:
+    """Each distinct track once, named by its first holder (flights on one route share a track)."""
+    unique: dict[bytes, tuple[str, np.ndarray]] = {}
+    for name, w in tracks.items():
+        unique.setdefault(np.asarray(w, dtype=float).tobytes(), (name, np.asarray(w, dtype=float)))
+    return list(unique.values())
+
+
+def check_in_airspace(extent, tracks: Mapping[str, np.ndarray], source: str, kind: str = "route") -> None:
+    """Refuse a track outside the grid or at or below the ground (module docstring).
 
     Parameters
     ----------
-    scenario : Scenario
-        Supplies the city and ``network.tracks``.
     extent : (x_max, y_max, z_max)
         The scenario's grid, m (``uamopt.pipeline.scenario_grid(scenario).extent``).
     tracks : mapping name -> (n, 3) waypoints, m
         Routes of a network file or flights of a flights file.
-    cell : (Δx, Δy, Δz)
-        The file's cells, m (the grid its tracks were planned on).
     source, kind : str
         The file as the user named it (``--network net.json``) and what a track is in it (``route``,
         ``flight``): errors say ``<source>: <kind> <name>``.
@@ -62,37 +62,47 @@ def check_tracks(scenario: Scenario, extent, tracks: Mapping[str, np.ndarray], c
     Raises
     ------
     InputFileError
-        The first track that breaks a rule, with the point and what it hits; or the file's cells
-        would make a grid too large for memory (``grid.memory_limit_gb``).
+        The first track that breaks a rule, with the point.
     """
-    from uamopt.city import load_city
-    from uamopt.grid.grid import file_grid
-
-    def where(name: str) -> str:
-        return f"{source}: {kind} {name}"
-
     extent = np.asarray(extent, dtype=float)
-    unique: dict[bytes, tuple[str, np.ndarray]] = {}
-    for name, w in tracks.items():  # flights on one route share a track: check it once, name the first
-        unique.setdefault(np.asarray(w, dtype=float).tobytes(), (name, np.asarray(w, dtype=float)))
-    for name, w in unique.values():
+    for name, w in _unique(tracks):
         bad = np.any((w < -TOL_M) | (w > extent + TOL_M), axis=1)
         if bad.any():
             p = ", ".join(f"{v:g}" for v in w[np.argmax(bad)])
             raise InputFileError(f"waypoint ({p}) is outside the grid [0, {', '.join(f'{e:g}' for e in extent)}] m",
-                                 where(name), "move the track inside the airspace or enlarge grid.extent")
+                                 f"{source}: {kind} {name}", "move the track inside the airspace or enlarge grid.extent")
         if np.any(w[:, 2] <= TOL_M):
             p = ", ".join(f"{v:g}" for v in w[np.argmax(w[:, 2] <= TOL_M)])
-            raise InputFileError(f"waypoint ({p}) is on or below the ground (z ≤ 0)", where(name),
+            raise InputFileError(f"waypoint ({p}) is on or below the ground (z ≤ 0)", f"{source}: {kind} {name}",
                                  "give the track's altitudes in metres above the ground datum (Eq. 14's band)")
-    if scenario.network.tracks == "straight":
-        return
-    grid = file_grid(tuple(extent), tuple(cell), scenario.grid.memory_limit_gb, source)
-    surface = load_city(scenario, grid).surface_height
-    shape = np.asarray(grid.shape[:2]) - 1
-    for name, w in unique.values():
-        pts = _points(w, grid.cell)
-        ij = np.clip(np.floor(pts[:, :2] / np.asarray(grid.cell[:2])).astype(np.int64), 0, shape)
+
+
+def check_above_surface(tracks: Mapping[str, np.ndarray], surface: np.ndarray, cell, source: str,
+                        kind: str = "route") -> None:
+    """Refuse a track that passes below the city's surface (module docstring).
+
+    Parameters
+    ----------
+    tracks : mapping name -> (n, 3) waypoints, m
+        Tracks already inside the airspace (:func:`check_in_airspace`).
+    surface : (nx, ny) array, m
+        The city's surface height per column of the file's cells (``CityLayers.surface_height``
+        of the city built on those cells).
+    cell : (Δx, Δy, Δz)
+        The file's cells, m (the grid its tracks were planned on).
+    source, kind : str
+        As :func:`check_in_airspace`.
+
+    Raises
+    ------
+    InputFileError
+        The first track that passes through a building, with the point and the column.
+    """
+    cell = tuple(float(c) for c in cell)
+    shape = np.asarray(surface.shape[:2]) - 1
+    for name, w in _unique(tracks):
+        pts = _points(w, cell)
+        ij = np.clip(np.floor(pts[:, :2] / np.asarray(cell[:2])).astype(np.int64), 0, shape)
         top = surface[ij[:, 0], ij[:, 1]]
         inside = pts[:, 2] < top - TOL_M
         if inside.any():
@@ -100,6 +110,6 @@ def check_tracks(scenario: Scenario, extent, tracks: Mapping[str, np.ndarray], c
             at = ", ".join(f"{v:.1f}" for v in pts[k])
             raise InputFileError(
                 f"the track passes through a building: ({at}) is below the city's surface at {top[k]:.1f} m "
-                f"(column {tuple(int(v) for v in ij[k])} of {', '.join(f'{c:g}' for c in grid.cell)} m cells)",
-                where(name), "re-plan it with `uamopt network` or lift it above the roofs; set network.tracks = "
-                "'straight' to schedule tracks that ignore the city")
+                f"(column {tuple(int(v) for v in ij[k])} of {', '.join(f'{c:g}' for c in cell)} m cells)",
+                f"{source}: {kind} {name}", "re-plan it with `uamopt network` or lift it above the roofs; set "
+                "network.tracks = 'straight' to schedule tracks that ignore the city")

@@ -83,7 +83,7 @@ def paper_case_plan(
     >>> grid = AirspaceGrid.from_extent(scenario.grid.cell, scenario.grid.extent)
     >>> plan = paper_case_plan(scenario, straight_network(scenario, grid, layer_offset_cells=1))
     >>> greedy = solve(build_problem(plan, scenario), "greedy")
-    >>> greedy.operated_count, greedy.cancelled, greedy.total_delay_s
+    >>> greedy.operated_count, greedy.cancelled_count, greedy.total_delay_s
     (104, 16, 2260.0)
 
     Raises

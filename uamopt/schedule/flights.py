@@ -28,7 +28,7 @@ from __future__ import annotations
 import json
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from functools import cached_property
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -188,6 +188,11 @@ class FlightSet:
     outbound_gap_s: float = 240.0  # T_D, s (Eq. 28)
     return_gap_s: float = 360.0  # T_R, s (Eq. 28)
     notes: tuple[str, ...] = ()  # how the generator adapted the plan (written to summary.json)
+    # A window of a larger day (the rolling solver's sub-problems) keeps the day's aircraft chains
+    # and precedence: a fixed flight's new departure must not re-sort its chain, and a sub-chain may
+    # start with a return. None: derived from the flights (:attr:`chains`, :attr:`requires`).
+    chain_order: tuple[np.ndarray, ...] | None = field(default=None, repr=False)
+    outbound_of: np.ndarray | None = field(default=None, repr=False)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "cell", tuple(float(c) for c in self.cell))
@@ -219,7 +224,10 @@ class FlightSet:
     # --- per-aircraft chains ------------------------------------------------------------
     @cached_property
     def chains(self) -> tuple[np.ndarray, ...]:
-        """Flight indices of each aircraft in planned-departure order, aircraft in first-seen order."""
+        """Flight indices of each aircraft in planned-departure order, aircraft in first-seen order
+        (or :attr:`chain_order` when given)."""
+        if self.chain_order is not None:
+            return tuple(_frozen(np.asarray(c, dtype=np.int64)) for c in self.chain_order)
         by_aircraft: dict[str, list[int]] = {}
         for i, f in enumerate(self.flights):
             by_aircraft.setdefault(f.aircraft, []).append(i)
@@ -261,7 +269,10 @@ class FlightSet:
         """For a return (even leg): the index of its outbound, which it needs operated; else −1.
 
         A cancelled outbound cancels its return: the aircraft never left (docs/readings.md).
+        Given as :attr:`outbound_of` for a window of a larger day.
         """
+        if self.outbound_of is not None:
+            return _frozen(np.asarray(self.outbound_of, dtype=np.int64))
         return _frozen(np.where(self.leg % 2 == 0, self.previous, -1))
 
     @cached_property

@@ -294,7 +294,13 @@ class Schedule:
         return int(np.sum(self.operated))
 
     @property
-    def cancelled(self) -> int:
+    def cancelled(self) -> np.ndarray:
+        """1 − c_f: the flights not operated, bool (n,), as :attr:`operated`."""
+        return ~np.asarray(self.operated, dtype=bool)
+
+    @property
+    def cancelled_count(self) -> int:
+        """N − S: how many flights are cancelled."""
         return int(len(self.operated) - self.operated_count)
 
     @property
@@ -326,7 +332,7 @@ class Schedule:
                  if key in self.extras}
         return {
             "solver": self.solver, "status": self.status, "objective": self.objective, "bound": self.bound,
-            "gap": self.gap, **named, "operated": self.operated_count, "cancelled": self.cancelled,
+            "gap": self.gap, **named, "operated": self.operated_count, "cancelled": self.cancelled_count,
             "total_delay_s": self.total_delay_s, "avg_delay_s": self.avg_delay_s,
             "solve_seconds": self.solve_seconds, "seed": self.seed,
         }

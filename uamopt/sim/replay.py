@@ -6,7 +6,7 @@ headless in fast time in a fresh process (:mod:`uamopt.sim.worker`), and compare
 flew with our plan:
 
 - losses of separation found by BlueSky's own state-based detection, its protected zone derived
-  from our conflict zone (:mod:`uamopt.sim.zone`: a verified schedule gives none while every
+  from our conflict zone (:mod:`uamopt.export.zone`: a verified schedule gives none while every
   flight stays within the deviation budget);
 - per pair that came near: the closest approach and the smallest horizontal distance;
 - per flight: largest cross-track distance to the track, largest horizontal and vertical error
@@ -44,13 +44,13 @@ from uamopt.export.bluesky import (
     transition_error_m,
 )
 from uamopt.export.folder import ScheduleFolder, read_schedule_folder
-from uamopt.sim.analysis import flight_deviation, pair_separations
-from uamopt.sim.zone import (
+from uamopt.export.zone import (
     DEFAULT_BUDGET_H_M,
     DEFAULT_BUDGET_V_M,
     ProtectedZone,
     protected_zone,
 )
+from uamopt.sim.analysis import flight_deviation, pair_separations
 
 INSTALL_HINT = "install the simulator with: pip install 'uamopt[sim]' (PyPI bluesky-simulator)"
 
@@ -142,7 +142,7 @@ def replay(path: str | Path, *, dt_s: float = DEFAULT_DT_S, bank_deg: float = DE
     bank_deg : float
         Bank limit of every aircraft, degrees (turn radius v²/(g tan φ)).
     budget_h_m, budget_v_m : float
-        e_h, e_v: the deviation from the plan the protected zone allows for, m (:mod:`uamopt.sim.zone`).
+        e_h, e_v: the deviation from the plan the protected zone allows for, m (:mod:`uamopt.export.zone`).
     zone_m : (r_pz, h_pz), optional
         An explicit protected zone, m, instead of the derived one.
     window_s : (t0, t1), optional
@@ -169,7 +169,7 @@ def replay(path: str | Path, *, dt_s: float = DEFAULT_DT_S, bank_deg: float = DE
     if not bluesky_available():
         raise UamoptError("BlueSky is not installed", "uamopt replay", INSTALL_HINT)
     folder = read_schedule_folder(path)
-    from uamopt.experiments.progress import Steps
+    from uamopt.progress import Steps
 
     with Steps(3, "replay") as bar:  # plain lines off a terminal once it has run 5 s (the simulation takes ~1 min)
         return _replay(folder, bar, started, dt_s=dt_s, bank_deg=bank_deg, budget_h_m=budget_h_m,

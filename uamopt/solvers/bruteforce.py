@@ -26,12 +26,16 @@ from __future__ import annotations
 
 import itertools
 import time
+from typing import TYPE_CHECKING
 
 import numpy as np
 from scipy.optimize import linprog
 
 from uamopt.errors import UamoptError
 from uamopt.schedule.model import Schedule, SchedulingProblem, make_schedule
+
+if TYPE_CHECKING:
+    from uamopt.solvers import SolverProfile
 
 SHAPES = frozenset({"bounds", "must_operate", "precedence", "turnaround", "pairs", "cumulative"})  # every shape
 OBJECTIVES = frozenset({"weighted", "lexicographic", "earliness_tardiness"})
@@ -139,7 +143,7 @@ def least_delay(problem: SchedulingProblem, operated: np.ndarray) -> tuple[float
     return float(problem.objective.delay_cost(delay[flown], np.asarray(flown)).sum()), delay
 
 
-def solve(problem: SchedulingProblem, profile=None) -> Schedule:
+def solve(problem: SchedulingProblem, profile: SolverProfile | None = None) -> Schedule:
     """The exact optimum by enumeration (see the module docstring); ``profile`` is ignored.
 
     Raises

@@ -39,7 +39,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -50,6 +50,8 @@ from uamopt.schedule.model import Schedule, SchedulingProblem, Status, make_sche
 
 if TYPE_CHECKING:
     from ortools.sat.python import cp_model
+
+    from uamopt.solvers import SolverProfile
 
 ROUND_S = 1e-9  # float round-off accepted when rounding a real time to units, s
 INT_LIMIT = 2**62  # keep |objective| below this (CP-SAT uses int64)
@@ -198,8 +200,26 @@ SHAPES = frozenset(ENCODERS)
 OBJECTIVES = frozenset({"weighted", "lexicographic", "earliness_tardiness"})
 
 
-def build_cpsat(problem: SchedulingProblem, unit_s: float = 0.01, rounding: str = "outer", extra=None):
-    """The CP-SAT model; returns (model, operate vars, delay vars in units, per-unit coef, per-flight coef, divisor, how).
+@dataclass(frozen=True)
+class CpsatModel:
+    """A built CP-SAT model of a scheduling problem (:func:`build_cpsat`).
+
+    ``operate[f]`` and ``delay[f]`` (in units of ``unit_s``) are the decision variables; the
+    objective is ``per_unit · Σ delay − per_flight · Σ operate`` (plus the per-flight terms), an
+    integer scaling of the problem's objective: divide by ``divisor`` (``how`` names the scaling,
+    :func:`objective_bound` reads a bound back)."""
+
+    model: Any
+    operate: list
+    delay: list
+    per_unit: int
+    per_flight: int
+    divisor: float
+    how: str
+
+
+def build_cpsat(problem: SchedulingProblem, unit_s: float = 0.01, rounding: str = "outer", extra=None) -> CpsatModel:
+    """The CP-SAT model of ``problem`` on the delay lattice of ``unit_s`` (:class:`CpsatModel`).
 
     ``rounding = "inner"`` reads k as the *cell* [k u, (k+1) u) of a continuous delay and forbids
     only what every point of a cell pair breaks (as timeindexed.py's ``relaxed`` model): a
@@ -242,7 +262,7 @@ def build_cpsat(problem: SchedulingProblem, unit_s: float = 0.01, rounding: str 
         extra_units = operate_units(problem, unit_s)  # per-flight operating costs (a speed change), in delay units
         model.minimize(per_unit * sum(delay) - per_flight * sum(operate)
                        + per_unit * sum(int(c) * operate[f] for f, c in enumerate(extra_units.tolist()) if c))
-    return model, operate, delay, per_unit, per_flight, divisor, how
+    return CpsatModel(model, operate, delay, per_unit, per_flight, divisor, how)
 
 
 def lattice_is_exact(problem: SchedulingProblem, unit_s: float, how: str) -> bool:
@@ -279,18 +299,19 @@ def objective_bound(problem: SchedulingProblem, raw: float, per_flight: int, div
     return s0 + unit_s * max(0.0, raw - per_flight * s0) * problem.objective.per_delay
 
 
-def _solver(profile, options: dict, limit_s: float):
-    """A CpSolver with the profile's limit, threads, seed and options."""
+def cp_solver(limit_s: float, threads: int, seed: int, options: dict | None = None, where: str = "profile cpsat"):
+    """A CpSolver with the time limit, threads, seed and CP-SAT ``options`` (``where`` names their
+    source in the error of an unknown option); Ctrl-C stays with Python (uamopt.interrupts)."""
     from ortools.sat.python import cp_model
 
     solver = cp_model.CpSolver()
     solver.parameters.max_time_in_seconds = float(limit_s)
-    solver.parameters.num_workers = int(profile.threads)
-    solver.parameters.random_seed = int(profile.seed)
+    solver.parameters.num_workers = int(threads)
+    solver.parameters.random_seed = int(seed)
     # CP-SAT's default small portfolios carry no max-LP worker and cannot close the bound of the
     # paper case in 60 s; with the big-M linear relaxation (level 2) they prove it in about 1 s
-    options = dict(options)
-    if int(profile.threads) == 1:
+    options = dict(options or {})
+    if int(threads) == 1:
         options.setdefault("linearization_level", 2)
     else:
         options.setdefault("subsolvers", ["max_lp", "default_lp"])
@@ -301,13 +322,18 @@ def _solver(profile, options: dict, limit_s: float):
             else:
                 setattr(solver.parameters, key, value)
         except (AttributeError, TypeError, ValueError) as exc:
-            raise UamoptError(f"unknown or invalid CP-SAT option '{key}': {exc}", f"profile {profile.name or 'cpsat'}",
+            raise UamoptError(f"unknown or invalid CP-SAT option '{key}': {exc}", where,
                               "see ortools/sat/sat_parameters.proto") from None
     solver.parameters.catch_sigint_signal = False  # its own Ctrl-C handler swallows the interrupt (uamopt.interrupts)
     return solver
 
 
-def solve(problem: SchedulingProblem, profile, extra=None) -> Schedule:
+def _solver(profile: SolverProfile, options: dict, limit_s: float):
+    """A CpSolver for ``profile``."""
+    return cp_solver(limit_s, profile.threads, profile.seed, options, f"profile {profile.name or 'cpsat'}")
+
+
+def solve(problem: SchedulingProblem, profile: SolverProfile, extra=None) -> Schedule:
     """Solve the discretised model with CP-SAT; status optimal | time_limit | infeasible, from CP-SAT's
     own termination (OPTIMAL: proved on the u-lattice model; FEASIBLE: stopped by the time limit,
     the only limit set). Hinted with the best cheap heuristic schedule on the ΔT_a grid
@@ -330,7 +356,9 @@ def solve(problem: SchedulingProblem, profile, extra=None) -> Schedule:
     options = {k: v for k, v in profile.options.items() if k not in ("time_unit_s", "continuous_bound")}  # CP-SAT's own
     t0 = time.perf_counter()
     small = reduced(problem)  # dominance caps (warmstart.py): the same optima
-    model, operate, delay, _, per_flight, divisor, how = build_cpsat(small, unit_s, extra=extra)
+    built = build_cpsat(small, unit_s, extra=extra)
+    model, operate, delay, per_flight, divisor, how = (built.model, built.operate, built.delay, built.per_flight,
+                                                       built.divisor, built.how)
     start = no_start() if extra is not None else warm_start(problem, seed=profile.seed, on_grid=True)
     # (a heuristic schedule knows nothing of the callback's rows: no start, and no fallback to one)
     if start.found:
@@ -381,16 +409,17 @@ def solve(problem: SchedulingProblem, profile, extra=None) -> Schedule:
         schedule.extras.update(continuous_bound=schedule.bound, continuous_bound_model="the exact lattice (lattice_exact)",
                                optimal_within=schedule.objective - schedule.bound)
     elif want_bound and profile.time_limit_s - (time.perf_counter() - t0) > 0.5:
-        inner, i_op, i_delay, _, i_flight, i_div, i_how = build_cpsat(small, unit_s, rounding="inner", extra=extra)
+        inner = build_cpsat(small, unit_s, rounding="inner", extra=extra)
         for f in range(n):  # the outer solution is a point of the relaxation
-            inner.add_hint(i_op[f], bool(operated[f]))
-            inner.add_hint(i_delay[f], int(delay_k[f]))
+            inner.model.add_hint(inner.operate[f], bool(operated[f]))
+            inner.model.add_hint(inner.delay[f], int(delay_k[f]))
         left = max(0.05, profile.time_limit_s - (time.perf_counter() - t0))
         relaxed = _solver(profile, options, left)
         with stopping(relaxed.stop_search):
-            r_code = relaxed.solve(inner)
+            r_code = relaxed.solve(inner.model)
         if r_code in (cp_model.OPTIMAL, cp_model.FEASIBLE, cp_model.UNKNOWN):
-            low = objective_bound(problem, relaxed.best_objective_bound, i_flight, i_div, unit_s, i_how)
+            low = objective_bound(problem, relaxed.best_objective_bound, inner.per_flight, inner.divisor, unit_s,
+                                  inner.how)
             schedule.extras.update(continuous_bound=low, continuous_bound_termination=relaxed.status_name(r_code),
                                    continuous_bound_model=f"delay cells {unit_s:g} s (relaxation of the continuous model)",
                                    optimal_within=schedule.objective - low)

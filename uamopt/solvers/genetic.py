@@ -48,6 +48,7 @@ import dataclasses
 import math
 import time
 from dataclasses import dataclass, fields
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -64,6 +65,9 @@ from uamopt.solvers.greedy import (  # noqa: F401  (SHAPES, OBJECTIVES: the deco
     decoder_for,
 )
 from uamopt.solvers.options import refuse_unknown
+
+if TYPE_CHECKING:
+    from uamopt.solvers import SolverProfile
 
 
 @dataclass(frozen=True)
@@ -274,7 +278,7 @@ class _Best:
         self.history.append(self.w)
 
 
-def solve(problem: SchedulingProblem, profile) -> Schedule:
+def solve(problem: SchedulingProblem, profile: SolverProfile) -> Schedule:
     """Run ``ga`` or ``soa`` (``profile.solver``) on the problem; see the module docstring."""
     if profile.solver not in ("ga", "soa"):
         raise UamoptError(f"genetic.solve cannot run solver '{profile.solver}'", "uamopt.solvers.genetic", "use ga or soa")

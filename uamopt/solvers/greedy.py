@@ -32,10 +32,14 @@ from __future__ import annotations
 import time
 import weakref
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from uamopt.schedule.model import Schedule, SchedulingProblem, Status, make_schedule
+
+if TYPE_CHECKING:
+    from uamopt.solvers import SolverProfile
 
 CANCEL = -1  # gene value meaning "cancel this flight" (Fig. 14 extended with a cancel allele)
 DEFAULT_STEP_S = 10.0  # ΔT_a, s (Table B.3)
@@ -245,7 +249,7 @@ def base_genes(problem: SchedulingProblem, step_s: float) -> np.ndarray:
     return np.floor(pref / step_s + EPS_S / step_s).astype(np.int64)
 
 
-def solve(problem: SchedulingProblem, profile) -> Schedule:
+def solve(problem: SchedulingProblem, profile: SolverProfile) -> Schedule:
     """The preliminary strategy as a solver: status "feasible" (``infeasible`` when a must-operate
     flight cannot be placed), no bound."""
     step_s, exact = profile.option("step_s", problem.time_step_s), profile.option("exact_gaps")

@@ -48,6 +48,7 @@ from __future__ import annotations
 import logging
 import time
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pyomo.environ as pyo
@@ -59,6 +60,9 @@ from uamopt.interrupts import quiet_on_interrupt, stopping
 from uamopt.schedule.flights import TIME_TOL_S
 from uamopt.schedule.model import Schedule, SchedulingProblem, Status, make_schedule
 from uamopt.solvers.deadline import interrupt_at
+
+if TYPE_CHECKING:
+    from uamopt.solvers import SolverProfile
 
 quiet_on_interrupt("pyomo.core")  # Ctrl-C while a model is built: no "ERROR: Constructing component" line
 
@@ -358,7 +362,7 @@ def least_cost_delays(problem: SchedulingProblem, operated: np.ndarray, chosen: 
     return delay
 
 
-def _choices(m: pyo.ConcreteModel, operated: np.ndarray) -> dict[int, tuple[float, float]]:
+def chosen_gaps(m: pyo.ConcreteModel, operated: np.ndarray) -> dict[int, tuple[float, float]]:
     """The gap each operated pair sits in, read from the MILP's binaries."""
     chosen = {}
     for k, (p, q, gaps, _, _) in enumerate(m.gaps_of):
@@ -405,7 +409,7 @@ def mip_start(m: pyo.ConcreteModel, problem: SchedulingProblem, operated: np.nda
     return values
 
 
-def solve(problem: SchedulingProblem, profile, extra=None) -> Schedule:
+def solve(problem: SchedulingProblem, profile: SolverProfile, extra=None) -> Schedule:
     """Build and solve the MILP with HiGHS; a linopy-style status, never an exception on a limit.
 
     Status: ``optimal`` (proved, within ``mip_rel_gap``), ``time_limit`` (limit hit; the incumbent
@@ -472,7 +476,7 @@ def solve(problem: SchedulingProblem, profile, extra=None) -> Schedule:
     if has_solution:
         result.solution_loader.load_vars()
         operated = np.array([pyo.value(m.operate[f]) > 0.5 for f in range(n)])
-        chosen, orders = _choices(m, operated), _orders(m, operated)
+        chosen, orders = chosen_gaps(m, operated), _orders(m, operated)
         polished = (least_delays(problem, operated, chosen, orders) if not problem.objective.per_flight_terms
                     else least_cost_delays(problem, operated, chosen, orders))
         if extra is not None and polished is not None:  # rows of the callback the polishing does not know

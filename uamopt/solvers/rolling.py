@@ -59,6 +59,7 @@ from __future__ import annotations
 
 import dataclasses
 import time
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -68,6 +69,9 @@ from uamopt.schedule.flights import TIME_TOL_S
 from uamopt.schedule.model import Schedule, SchedulingProblem, Status, make_schedule, violations
 from uamopt.schedule.occupancy import ConflictTable
 from uamopt.solvers.greedy import greedy_decisions
+
+if TYPE_CHECKING:
+    from uamopt.solvers import SolverProfile
 
 SHAPES = frozenset({"bounds", "must_operate", "precedence", "turnaround", "pairs", "cumulative"})
 #: its sub-problems rebuild the paper's five families from a sub flight set, and carry ``pads``
@@ -124,9 +128,8 @@ def subproblem(problem: SchedulingProblem, free: np.ndarray, fixed: np.ndarray, 
     is_fixed[fixed] = True
     flights = tuple(dataclasses.replace(fs.flights[i], planned_departure_s=float(departure[i]), max_delay_s=0.0)
                     if is_fixed[i] else fs.flights[i] for i in index.tolist())
-    sub_fs = dataclasses.replace(fs, flights=flights)
     # the chains in the original order (a fixed flight's new departure could reorder a re-sort), and
-    # the original precedence (a sub-chain may start with a return): set the cached views directly
+    # the original precedence (a sub-chain may start with a return): given to the FlightSet
     chains = []
     for chain in fs.chains:
         members = pos[chain]
@@ -139,10 +142,7 @@ def subproblem(problem: SchedulingProblem, free: np.ndarray, fixed: np.ndarray, 
     if np.any(free_mask & (req >= 0) & (sub_req < 0)):
         raise UamoptError("a free return's outbound is missing from its window's sub-problem", "solver rolling",
                           "report this as a bug")
-    for key in ("chains", "leg", "previous", "requires", "aircraft_index"):
-        sub_fs.__dict__.pop(key, None)
-    sub_fs.__dict__["chains"] = tuple(chains)
-    sub_fs.__dict__["requires"] = sub_req
+    sub_fs = dataclasses.replace(fs, flights=flights, chain_order=tuple(chains), outbound_of=sub_req)
     # conflicts with at least one free flight, re-indexed (pos is increasing, so p < q and the order hold)
     c = problem.conflicts
     keep = (pos[c.p] >= 0) & (pos[c.q] >= 0) & ~(is_fixed[c.p] & is_fixed[c.q])
@@ -163,22 +163,15 @@ def _inner_cpsat(sub: SchedulingProblem, hint: tuple[np.ndarray, np.ndarray], li
                  threads: int, seed: int, unit_s: float) -> tuple[np.ndarray, np.ndarray, bool] | None:
     from ortools.sat.python import cp_model
 
-    from uamopt.solvers.cpsat import build_cpsat
+    from uamopt.solvers.cpsat import build_cpsat, cp_solver
 
-    model, operate, delay, *_ = build_cpsat(sub, unit_s)  # the fixed flights must operate (sub.must_operate)
+    built = build_cpsat(sub, unit_s)  # the fixed flights must operate (sub.must_operate)
+    model, operate, delay = built.model, built.operate, built.delay
     h_op, h_d = hint
     for i in range(sub.n_flights):
         model.add_hint(operate[i], bool(h_op[i]))
         model.add_hint(delay[i], int(np.rint(h_d[i] / unit_s)) if h_op[i] else 0)
-    solver = cp_model.CpSolver()
-    solver.parameters.max_time_in_seconds = float(limit_s)
-    solver.parameters.num_workers = int(threads)
-    solver.parameters.random_seed = int(seed)
-    solver.parameters.catch_sigint_signal = False  # its own Ctrl-C handler swallows the interrupt (uamopt.interrupts)
-    if threads == 1:
-        solver.parameters.linearization_level = 2
-    else:
-        solver.parameters.subsolvers.extend(["max_lp", "default_lp"])
+    solver = cp_solver(limit_s, threads, seed, where="profile rolling")  # CP-SAT's settings, one copy
     with stopping(solver.stop_search):
         code = solver.solve(model)
     if code not in (cp_model.OPTIMAL, cp_model.FEASIBLE):
@@ -206,7 +199,7 @@ def _inner_highs(sub: SchedulingProblem, limit_s: float, threads: int, seed: int
         return None
     result.solution_loader.load_vars()
     operated = np.array([pyo.value(m.operate[f]) > 0.5 for f in range(sub.n_flights)])
-    delay = milp.least_delays(sub, operated, milp._choices(m, operated))
+    delay = milp.least_delays(sub, operated, milp.chosen_gaps(m, operated))
     if delay is None:
         delay = np.where(operated, np.clip([pyo.value(m.delay[f]) for f in range(sub.n_flights)], 0.0, sub.delay_upper_s), 0.0)
     proved = result.termination_condition == TerminationCondition.convergenceCriteriaSatisfied
@@ -219,7 +212,7 @@ def _options(profile) -> dict:
     return {key: profile.option(key) for key in ("inner", "window_s", "window_time_limit_s", "time_unit_s", "step_s")}
 
 
-def solve(problem: SchedulingProblem, profile) -> Schedule:
+def solve(problem: SchedulingProblem, profile: SolverProfile) -> Schedule:
     """Rolling horizon (module docstring); never worse than the whole-problem warm start
     (:mod:`~uamopt.solvers.warmstart`: greedy, greedy with exact gaps), which it returns instead
     when the windows end worse (``extras["incumbent"]``)."""

@@ -69,6 +69,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -78,6 +79,9 @@ from uamopt.schedule.flights import TIME_TOL_S
 from uamopt.schedule.model import Schedule, SchedulingProblem, Status, make_schedule
 from uamopt.solvers.deadline import highs_can_start, interrupt_at, quiet_highs
 from uamopt.solvers.warmstart import Start, no_schedule, no_worse, reduced, warm_start
+
+if TYPE_CHECKING:
+    from uamopt.solvers import SolverProfile
 
 SHAPES = frozenset({"bounds", "must_operate", "precedence", "turnaround", "pairs", "cumulative"})  # build_grid_model
 OBJECTIVES = frozenset({"weighted", "lexicographic", "earliness_tardiness"})
@@ -468,7 +472,7 @@ def _grid_is_exact(problem: SchedulingProblem, step_s: float) -> bool:
 
 
 # --- the solver ------------------------------------------------------------------------------------
-def solve(problem: SchedulingProblem, profile) -> Schedule:
+def solve(problem: SchedulingProblem, profile: SolverProfile) -> Schedule:
     """Build the time-indexed model, warm-start it, solve it; see the module docstring."""
     o = profile.option  # typed and checked by the profile (uamopt.solvers.options)
     step, kind, engine, gap, cont_s = (o(k) for k in ("step_s", "model", "engine", "mip_rel_gap", "continuous_bound_s"))

@@ -1,4 +1,4 @@
-"""The ``export`` and ``replay`` subcommands (docs/interfaces.md), added to the main parser by one call.
+"""The ``export`` and ``replay`` subcommands (docs/interfaces.md), added to the main parser by :mod:`uamopt.cli`.
 
     uamopt export bluesky DIR [--dt S] [--bank DEG] [--trajectory designed|waypoints] [--zone RPZ,HPZ]
                               [--budget EH,EV]                                       # DIR/bluesky.scn
@@ -55,7 +55,7 @@ def _simulation_options(p) -> None:
 
 def _zone(args, folder_path: str):
     from uamopt.export.folder import read_schedule_folder
-    from uamopt.sim.zone import DEFAULT_BUDGET_H_M, DEFAULT_BUDGET_V_M, protected_zone
+    from uamopt.export.zone import DEFAULT_BUDGET_H_M, DEFAULT_BUDGET_V_M, protected_zone
 
     if not 0 < args.dt <= MAX_DT_S or not 0 < args.bank < 90:  # a step longer than a flight samples nothing
         raise UamoptError(f"--dt {args.dt:g} or --bank {args.bank:g} out of range", "command line",

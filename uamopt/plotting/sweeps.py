@@ -30,11 +30,12 @@ from pathlib import Path
 
 import numpy as np
 
+from uamopt.paper import table4_row
+
 #: swept key of each study (its x axis)
 KEYS = {"altitude": "network.cruise_altitude_m", "cell": "grid.cell", "weights": "tracks.weights",
         "flights": "schedule.flights", "speed": "aircraft.cruise_speed_mps", "pads": "network.pads"}
 #: the paper's Table 4 (optimal tracks at 10 m and 5 m cells): risk, ¥, waypoints, seconds
-PAPER_TABLE4 = {"[10.0, 10.0, 10.0]": (196.0, 27.1527, 386, 68.71), "[5.0, 5.0, 5.0]": (163.33, 25.7975, 636, 659.52)}
 #: the metric drawn when ``y`` is not given, by the stage the sweep ran to
 DEFAULT_METRIC = {"schedule": "avg_delay_s", "network": "risk_cost", "plan": "risk_cost", "risk": "cruise_unsafe_share"}
 #: metrics computed from the table's columns
@@ -289,7 +290,7 @@ def _cell(table, key: str, ax):
     pos = np.arange(len(labels))
     for i, (a, (column, title)) in enumerate(zip(axes, metrics, strict=False)):
         a.bar(pos - 0.2, rows[column].astype(float), width=0.4, label="uamopt")
-        paper = [PAPER_TABLE4.get(label, (np.nan,) * 4)[i] for label in labels]
+        paper = [(table4_row(str(cell).strip("[]").split(",")) or (np.nan,) * 4)[i] for cell in rows[key]]
         if np.isfinite(paper).any():
             a.bar(pos + 0.2, paper, width=0.4, label="paper (Table 4)")
         a.set_xticks(pos, [label.replace(".0", "") for label in labels], fontsize=8)
@@ -374,7 +375,7 @@ def plot_sweep(table, kind: str | None = None, ax=None, *, x: str | None = None,
 
 def save_sweep_figure(table, spec, path: str | Path) -> Path:
     """Draw ``spec.figure`` from ``table`` into ``path`` (PNG, written atomically)."""
-    from uamopt.experiments.store import atomic_write
+    from uamopt.outputs import atomic_write
     from uamopt.plotting.style import DPI
 
     fig = plot_sweep(table, spec.figure)
