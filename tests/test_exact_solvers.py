@@ -96,22 +96,8 @@ def test_paper_case_highs_and_cpsat(paper_problem, paper_highs):
     assert discrete.objective - exact.objective - OBJ_TOL <= discrete.summary()["optimal_within"] < 0.05 * abs(exact.objective)
 
 
-def test_milp_model_is_inspectable(paper_problem):
-    m = milp.build_model(paper_problem)
-    n = paper_problem.n_flights
-    assert len(m.operate) == n and len(m.delay) == n
-    assert len(m.precedence) == int(np.sum(paper_problem.requires >= 0))
-    singles = sum(len(gaps) == 1 for _, _, gaps, _, _ in m.gaps_of)
-    multis = sum(len(gaps) for _, _, gaps, _, _ in m.gaps_of if len(gaps) > 1)
-    assert len(m.in_gap) == multis and len(m.gaps_of) == len(paper_problem.conflicts) and singles > 0
-
-
-def test_hand_checked_instance():
-    """Aircraft A flies e then f, B flies b1 then b2 (10 s each, T_D = 5 s, Δd = 10 s, b's 0).
-    Forbidden: dep_b1 − dep_e ∈ (−9.5, 1) and dep_b2 − dep_f ∈ (−11, 1), so either e waits
-    9.5 s and f is cancelled (S = 3), or an aircraft loses a flight pair (S = 2). With
-    (ω6, ω7) = (0.1, 0.9), G = 2: W = 0.1·9.5/2 − 0.9·3 = −2.225 < −1.8. It also pins the big-M of
-    the turnaround row (e, f) at c_f = 0: e's delay of 9.5 s near U_e must stay allowed."""
+def hand_checked_problem() -> SchedulingProblem:
+    """The instance of :func:`test_hand_checked_instance` (docstring there): e, f of A; b1, b2 of B."""
     track = np.array([[0.0, 0.0, 0.0], [100.0, 0.0, 0.0]])
 
     def flight(fid, aircraft, departure, max_delay):
@@ -123,7 +109,90 @@ def test_hand_checked_instance():
                             flight("b1", "B", 0.0, 0.0), flight("b2", "B", 15.0, 0.0)))
     table = ConflictTable(p=np.array([0, 1]), q=np.array([2, 3]), ptr=np.array([0, 1, 2]),
                           intervals=np.array([[-9.5, 1.0], [-11.0, 1.0]]))
-    problem = SchedulingProblem(flights=fs, conflicts=table, weights=(0.1, 0.9))
+    return SchedulingProblem(flights=fs, conflicts=table, weights=(0.1, 0.9))
+
+
+def broken_rows(m, operated, delay_s, in_gap=None, tol=1e-6) -> set[str]:
+    """The names of the Pyomo components (rows, and variable bounds as ``bounds of NAME``) that the
+    point (c, d, y) breaks; y defaults to 0. Evaluated by Pyomo on the built model, no solver."""
+    import pyomo.environ as pyo
+
+    for f, (c, d) in enumerate(zip(operated, delay_s, strict=True)):
+        m.operate[f].set_value(float(c))
+        m.delay[f].set_value(float(d))
+    for index in getattr(m, "gap_index", ()):
+        m.in_gap[index].set_value(float((in_gap or {}).get(index, 0.0)))
+    out = set()
+    for row in m.component_data_objects(pyo.Constraint, active=True):
+        body = pyo.value(row.body)
+        if (row.has_lb() and body < pyo.value(row.lower) - tol) or (row.has_ub() and body > pyo.value(row.upper) + tol):
+            out.add(row.parent_component().name)
+    for var in m.component_data_objects(pyo.Var):
+        if (var.lb is not None and var.value < var.lb - tol) or (var.ub is not None and var.value > var.ub + tol):
+            out.add(f"bounds of {var.parent_component().name}")
+    return out
+
+
+def test_milp_model_is_inspectable(paper_problem, paper_highs):
+    """The rows of ``build_model`` read by hand on the hand-checked instance, and evaluated at points
+    whose feasibility is known without the model; on the paper case, the model admits the verified
+    HiGHS optimum (the big-M rows cut no feasible schedule) and its objective expression there is
+    Eq. 20's lexicographic scalar recomputed by tests/oracles.py.
+
+    By hand (e = 0, f = 1, b1 = 2, b2 = 3; U = 10, 10, 0, 0 s; every need D_e + T_e + ΔT_e − D_f = 0):
+    the pair (e, b1) keeps δ = d_b1 − d_e out of (−9.5, 1) within its reach [−10, 0]: one gap
+    [−10, −9.5], no binary, one row δ ≤ −9.5 + 9.5 (2 − c_e − c_b1); the pair (f, b2) has reach
+    [−10, 0] inside (−11, 1): no gap, c_f + c_b2 ≤ 1; the turnaround (e, f) is
+    d_f − d_e ≥ −10 (1 − c_f) (M_f = need + U_e, M_e = need⁺ = 0) and (b1, b2) is dropped (need + U_b1 = 0)."""
+    import pyomo.environ as pyo
+
+    problem = hand_checked_problem()
+    m = milp.build_model(problem)
+    assert m.gaps_of == [(0, 2, [(-10.0, -9.5)], -10.0, 0.0), (1, 3, [], -10.0, 0.0)]
+    assert list(m.not_both) == [1] and len(m.gap_index) == 0 and list(m.gap_below) == [(0, 0)] and len(m.gap_above) == 0
+    assert list(m.turnaround) == [(0, 1)]
+    assert [pyo.value(m.delay[f].ub) for f in range(4)] == [10.0, 10.0, 0.0, 0.0]
+    # the optimum of test_hand_checked_instance: W = 0.1 · 9.5 / 2 − 0.9 · 3 = −2.225
+    assert broken_rows(m, [1, 0, 1, 1], [9.5, 0, 0, 0]) == set()
+    assert pyo.value(m.objective) == pytest.approx(-2.225, abs=1e-12)
+    assert broken_rows(m, [1, 0, 1, 1], [10.0, 0, 0, 0]) == set()  # δ = −10: the gap's other end
+    assert broken_rows(m, [1, 0, 1, 1], [5.0, 0, 0, 0]) == {"gap_below"}  # δ = −5 ∈ (−9.5, 1)
+    assert broken_rows(m, [1, 1, 1, 1], [9.5, 9.5, 0, 0]) == {"not_both"}  # f and b2 cannot both fly
+    assert broken_rows(m, [1, 1, 0, 0], [5.0, 0.0, 0, 0]) == {"turnaround"}  # f departs 5 s before e's turnaround ends
+    assert broken_rows(m, [1, 1, 0, 0], [5.0, 5.0, 0, 0]) == set()
+    assert broken_rows(m, [0, 1, 0, 0], [0, 0, 0, 0]) == {"precedence"}  # a return without its outbound
+    assert broken_rows(m, [0, 0, 0, 1], [0, 0, 0, 0]) == {"precedence"}
+    assert broken_rows(m, [0, 0, 1, 1], [3.0, 0, 0, 0]) == {"delay_if_operated"}  # a cancelled flight's delay is 0
+
+    # the paper case: the verified optimum, with y = 1 on the gap that holds each operated pair's δ
+    m = milp.build_model(paper_problem)
+    schedule = paper_highs
+    assert_verified(paper_problem, schedule)
+    y = gap_choice(m, paper_problem, schedule.operated, schedule.delay_s)
+    assert y and broken_rows(m, schedule.operated, schedule.delay_s, y) == set()
+    assert pyo.value(m.objective) == pytest.approx(original_objective(paper_problem, schedule), abs=1e-9)
+    flown, on_time = np.ones(paper_problem.n_flights, bool), np.zeros(paper_problem.n_flights)
+    assert broken_rows(m, flown, on_time, gap_choice(m, paper_problem, flown, on_time)) & {"gap_above", "gap_below", "not_both"}
+
+
+def gap_choice(m, problem: SchedulingProblem, operated, delay_s) -> dict:
+    """y of a decision: for each operated pair with several gaps, 1 on the gap nearest its δ."""
+    dep = problem.planned_departure_s + np.where(operated, delay_s, 0.0)
+    y = {}
+    for k, (p, q, gaps, _, _) in enumerate(m.gaps_of):
+        if len(gaps) > 1 and operated[p] and operated[q]:
+            delta = dep[q] - dep[p]
+            y[k, min(range(len(gaps)), key=lambda j: max(gaps[j][0] - delta, delta - gaps[j][1], 0.0))] = 1.0
+    return y
+
+
+def test_hand_checked_instance():
+    """Aircraft A flies e then f, B flies b1 then b2 (10 s each, T_D = 5 s, Δd = 10 s, b's 0).
+    Forbidden: dep_b1 − dep_e ∈ (−9.5, 1) and dep_b2 − dep_f ∈ (−11, 1), so either e waits
+    9.5 s and f is cancelled (S = 3), or an aircraft loses a flight pair (S = 2). With
+    (ω6, ω7) = (0.1, 0.9), G = 2: W = 0.1·9.5/2 − 0.9·3 = −2.225 < −1.8. It also pins the big-M of
+    the turnaround row (e, f) at c_f = 0: e's delay of 9.5 s near U_e must stay allowed."""
+    problem = hand_checked_problem()
     for schedule in (bruteforce.solve(problem), milp.solve(problem, HIGHS), cpsat.solve(problem, CPSAT)):
         check_feasible(problem, schedule)
         assert schedule.status == "optimal" and schedule.objective == pytest.approx(-2.225, abs=OBJ_TOL)

@@ -3,11 +3,11 @@
 from __future__ import annotations
 
 import itertools
-import math
 
 import networkx as nx
 import numpy as np
 import pytest
+from oracles import grid_shortest_length
 
 from uamopt.planning.graph import neighbour_moves, to_networkx
 
@@ -61,12 +61,28 @@ def test_no_corner_cutting_on_a_tiny_grid():
 
 
 def test_shortest_path_on_the_graph_is_a_valid_track(coarse):
+    """V1 → V4 at 150 m and at 90 m (a fifth of that layer's cells blocked): networkx's A* on the
+    graph is as long as the exact optimum of an independent Dijkstra over the passable cells
+    (tests/oracles.py: the same moves and lengths, written without the graph or uamopt), and every
+    step of its path is a 26-neighbour move whose bounding box is free."""
     G = to_networkx(coarse)
-    s = coarse.grid.index_of((300.0, 300.0, 150.0))
-    t = coarse.grid.index_of((2220.0, 4220.0, 150.0))
-    length = nx.astar_path_length(G, s, t, weight="length")
-    straight = math.dist(coarse.grid.centre_of(s), coarse.grid.centre_of(t))
-    assert straight <= length < 1.5 * straight
+    passable = ~(coarse.obstacle | coarse.no_fly)
+    cell = np.asarray(coarse.grid.cell)
+    for z in (150.0, 90.0):
+        s = coarse.grid.index_of((300.0, 300.0, z))
+        t = coarse.grid.index_of((2220.0, 4220.0, z))
+        path = nx.astar_path(G, s, t, weight="length")
+        optimum = grid_shortest_length(passable.tolist(), coarse.grid.cell, s, t)
+        assert nx.path_weight(G, path, weight="length") == pytest.approx(optimum, rel=1e-12), z
+        assert path[0] == s and path[-1] == t
+        walked = 0.0
+        for a, b in itertools.pairwise(path):
+            d = np.subtract(b, a)
+            assert np.abs(d).max() == 1, (a, b)  # a 26-neighbour
+            box = itertools.product(*[(0, x) if x else (0,) for x in d])
+            assert all(passable[tuple(np.add(a, corner))] for corner in box), (a, b)  # no corner cut
+            walked += float(np.linalg.norm(d * cell))
+        assert walked == pytest.approx(optimum, rel=1e-12)
 
 
 def test_neighbourhood_choice(coarse):

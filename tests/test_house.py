@@ -132,19 +132,6 @@ def test_the_grid_knows_nothing_of_cities():
         assert not [n for n, _ in imports(path) if n.startswith(("uamopt.city", "uamopt.risk"))], path.name
 
 
-def test_the_command_line_parser_loads_no_heavy_library():
-    """``uamopt --help`` and argument errors stay instant: building the parser imports no numerical
-    or plotting library (they load when a command runs)."""
-    import subprocess
-    import sys
-
-    code = ("import sys; from uamopt import cli; cli.build_parser(); "
-            "print(sorted(m for m in ('numpy', 'pandas', 'matplotlib', 'scipy', 'dask', 'pyomo', 'ortools', 'cvxpy')"
-            " if m in sys.modules))")
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, cwd=ROOT)
-    assert out.stdout.strip() == "[]"
-
-
 @pytest.mark.parametrize("path", sorted((ROOT / "uamopt").rglob("*.py")), ids=lambda p: str(p.relative_to(ROOT)))
 def test_no_module_imports_another_modules_private_names(path):
     """What one module needs of another is public there (docs/house.md): no ``from uamopt.x import _y``."""

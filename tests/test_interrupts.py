@@ -204,7 +204,7 @@ print("status", schedule.status, schedule.extras.get("termination"))
 
 @pytest.mark.slow
 def test_highs_stopped_at_its_deadline_prints_no_pyomo_warning():
-    """HiGHS stopped by uamopt's deadline callback (deadline.py) made Pyomo print "WARNING: Received
+    """HiGHS stopped by uamopt's deadline callback (solvers/highs.py) made Pyomo print "WARNING: Received
     unhandled status=<HighsModelStatus.kInterrupt: 17> from solver HiGHS." before every time-limit
     result (seen in uamopt bench on airland9). The status is the time limit, with no warning."""
     done = run(AT_DEADLINE, timeout=300)

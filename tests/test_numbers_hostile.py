@@ -20,7 +20,7 @@ import typing
 import pytest
 from conftest import PAPER_CASE, ROOT
 
-from uamopt import scenario as scenario_module
+from uamopt.scenario import key_ranges, schema as scenario_module
 
 GB = 2**30
 
@@ -46,7 +46,7 @@ def _numeric_keys(model, prefix: str = "") -> set[str]:
 
 def test_every_numeric_scenario_key_declares_a_finite_range():
     """The key table is the one boundary check of scenarios: no numeric key without both bounds."""
-    ranges = scenario_module.key_ranges()
+    ranges = key_ranges()
     numeric = _numeric_keys(scenario_module.Scenario)
     assert len(numeric) > 80 and numeric == set(ranges), sorted(numeric ^ set(ranges))
     for key, text in ranges.items():
@@ -57,7 +57,7 @@ def test_the_ranges_are_documented_in_interfaces_md():
     """docs/interfaces.md's table of ranges is the key table's, row for row."""
     doc = (ROOT / "docs" / "interfaces.md").read_text(encoding="utf-8")
     rows = dict(re.findall(r"^\| `([a-z0-9_.]+)` \| ([^|]+) \|$", doc, flags=re.MULTILINE))
-    expected = scenario_module.key_ranges()
+    expected = key_ranges()
     assert {k: rows.get(k, "").strip() for k in expected} == expected
 
 

@@ -107,9 +107,14 @@ def test_one_pad_is_kept_by_every_solver_and_binds(small):
         assert max_pad_load(pads[1], s, 1) <= 1, solver
         assert ua.verify(pads[1], s).ok, solver
         results[solver] = s
-    assert results["highs"].status == "optimal"
-    assert results["highs"].objective > unlimited.objective  # a real restriction
-    assert results["highs"].objective <= results["greedy"].objective + 1e-9
+    best = results["highs"]
+    assert best.status == "optimal" and best.bound == pytest.approx(best.objective, abs=1e-9 * abs(best.objective))
+    assert best.objective > unlimited.objective  # a real restriction
+    # the optimum against the schedules of solvers that do not start from HiGHS's (greedy is every exact
+    # solver's warm start, so "no worse than greedy" would hold by construction): CP-SAT's own model on its
+    # 0.01 s lattice, the 10 s delay grid, SOA and the rolling windows find nothing better
+    for solver in ("cpsat", "timeindexed", "soa", "rolling"):
+        assert results[solver].objective >= best.objective - 1e-6, solver
 
 
 def test_a_solver_without_the_cumulative_shape_refuses(small, monkeypatch):

@@ -10,8 +10,6 @@ from __future__ import annotations
 
 import dataclasses
 import struct
-import subprocess
-import sys
 
 import numpy as np
 import pytest
@@ -270,18 +268,10 @@ def test_save_follows_the_suffix(tmp_path):
     assert _png_size(plotting.save(fig, tmp_path / "b.png", dpi=50)) == (100, 50)
 
 
-def test_importing_uamopt_or_its_cli_does_not_load_matplotlib():
-    code = ("import sys, uamopt, uamopt.cli; uamopt.cli.build_parser().format_help(); "
-            "print(sorted(m for m in sys.modules if m.split('.')[0] == 'matplotlib')); "
-            "print(uamopt.plotting.tracks.__module__, 'matplotlib' in sys.modules)")
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
-    assert out.splitlines() == ["[]", "uamopt.plotting.tracks True"]  # loaded on first use of uamopt.plotting
-
-
 def test_a_returned_figure_displays_as_png_in_ipython():
     from IPython.core.interactiveshell import InteractiveShell
 
-    from uamopt.plotting.style import show_figures_in
+    from uamopt.plotting.output import show_figures_in
 
     shell = InteractiveShell.instance()
     formatter = shell.display_formatter.formatters["image/png"]

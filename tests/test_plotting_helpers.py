@@ -11,8 +11,10 @@ from matplotlib import colors, image
 from matplotlib.figure import Figure
 
 from uamopt import plotting
+from uamopt.plotting.draw import outline, runs
 from uamopt.plotting.geometry import along_track_m, pair_directions, route_waypoints
-from uamopt.plotting.style import OSM_CREDIT, attribution, inch_grid, outline, runs
+from uamopt.plotting.layout import attribution, inch_grid
+from uamopt.plotting.style import OSM_CREDIT
 
 
 def _credited(field, text: str, source: str | None = None):

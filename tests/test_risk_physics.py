@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
@@ -157,7 +158,21 @@ def test_average_of_a_constant_is_that_constant():
 
 
 def test_swept_volume():
-    assert float(swept_volume(2.0, 10.0, 5.63, 5.63, 1.855)) == pytest.approx(5.63 * 1.855 * (20.0 + 5.63))
+    """V_e = e_w e_h (v_r' t + e_l) (Eq. A.5): the volume a box e_l × e_w × e_h sweeps moving v_r' t
+    along its length. Every dimension differs, so a swapped argument shows; the reference is the
+    convex hull of the box at its start and its end (scipy), no formula of the code."""
+    from scipy.spatial import ConvexHull
+
+    length, width, height = 6.0, 2.0, 0.5
+    # by hand: 2 m × 0.5 m × (3 m/s · 4 s + 6 m) = 18 m³
+    assert float(swept_volume(4.0, 3.0, length, width, height)) == pytest.approx(18.0, rel=1e-12)
+    times = np.array([0.0, 0.5, 2.0, 7.323078])
+    box = np.array(list(itertools.product((0.0, length), (0.0, width), (0.0, height))))
+    for t, volume in zip(times, swept_volume(times, 23.664, length, width, height), strict=True):
+        moved = box + np.array([23.664 * t, 0.0, 0.0])
+        assert volume == pytest.approx(ConvexHull(np.vstack([box, moved])).volume, rel=1e-9)
+    # Table B.3's aircraft (e_l = e_w = 5.63 m, e_h = 1.855 m) at rest: the box itself, 58.7977 m³
+    assert float(swept_volume(0.0, 23.664, 5.63, 5.63, 1.855)) == pytest.approx(58.7977, abs=1e-4)
 
 
 def test_road_threshold_and_open_ground_bound():

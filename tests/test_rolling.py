@@ -5,6 +5,9 @@ than the exact optimum, reproducible; through the registry (``solve(p, "rolling"
 
 from __future__ import annotations
 
+import math
+import tomllib
+
 import numpy as np
 import pytest
 from checks import OBJ_TOL, assert_verified
@@ -13,7 +16,7 @@ from strategies import tiny_problems
 
 from uamopt.errors import UamoptError
 from uamopt.schedule import Flight, FlightSet, build_problem, generate_plan, violations
-from uamopt.solvers import SolverProfile, bruteforce, milp, rolling, solve
+from uamopt.solvers import SolverProfile, bruteforce, load_profile, milp, rolling, solve
 from uamopt.solvers.rolling import pair_matching_bound
 
 
@@ -27,15 +30,29 @@ def paper_optimum(paper_highs):
     return paper_highs.objective
 
 
+def windows_of(problem, window_s: float) -> int:
+    """The non-empty windows of ``window_s`` seconds of planned departure, counted from the first
+    (the rolling.py docstring), by hand from the flights."""
+    departures = [f.planned_departure_s for f in problem.flights.flights]
+    return len({math.floor((d - min(departures)) / window_s) for d in departures})
+
+
 def test_rolling_paper_case(paper_problem, paper_optimum):
+    """The paper case in its 900 s windows, each given 30 s: every window's CP-SAT solve proves its
+    optimum (about 0.3 s each, a hundredfold margin), so the status is ``feasible`` (a schedule with
+    a valid bound, never ``optimal``: the windows are not the whole day), with no greedy fallback and
+    no swap for the warm start."""
     problem = paper_problem
-    first = rolling.solve(problem, profile())
-    assert first.status in ("feasible", "time_limit") and first.solver == "rolling"
+    first = rolling.solve(problem, profile(window_time_limit_s=30.0))
+    assert first.status == "feasible" and first.solver == "rolling"
+    assert first.extras["windows"] == windows_of(problem, 900.0) == first.extras["proved"]
+    assert first.extras["unproved"] == first.extras["greedy_windows"] == first.extras["cancelled_windows"] == 0
+    assert "incumbent" not in first.extras and "fallback" not in first.extras and "windows_past_limit" not in first.extras
     assert violations(problem, first.operated, first.delay_s) == []
     assert_verified(problem, first)
     assert first.bound <= paper_optimum + OBJ_TOL <= first.objective + 2 * OBJ_TOL
     assert first.extras["windows"] > 1
-    again = rolling.solve(problem, profile())
+    again = rolling.solve(problem, profile(window_time_limit_s=30.0))
     assert np.array_equal(again.operated, first.operated) and np.array_equal(again.delay_s, first.delay_s)
     assert again.objective == first.objective
 
@@ -46,14 +63,24 @@ def test_rolling_highs_inner_and_bound(paper_problem, paper_optimum):
     assert s.bound <= paper_optimum + OBJ_TOL <= s.objective + 2 * OBJ_TOL
 
 
-def test_solve_by_name_uses_the_shipped_profile(paper_straight_plan):
-    """``solve(problem, "rolling")`` reads solvers/rolling.toml (900 s windows, CP-SAT inside). On 6
+def test_solve_by_name_uses_the_shipped_profile(paper_straight_plan, root):
+    """``solve(problem, "rolling")`` reads solvers/rolling.toml: the expectations come from that file,
+    read here with tomllib (window_s → the number of windows, counted from the flights; inner;
+    time_limit_s / windows → each window's limit; seed), not from uamopt's profile loader. On 6
     aircraft (36 flights) its windows cost it against the whole-day optimum, and its bound is valid."""
+    shipped = tomllib.loads((root / "solvers" / "rolling.toml").read_text(encoding="utf-8"))
     scenario, _, network, _ = paper_straight_plan
     problem = build_problem(generate_plan(scenario, network, seed=0, aircraft=6, max_delay_scale=1.0), scenario)
     s = solve(problem, "rolling")
     exact = milp.solve(problem, SolverProfile("highs", time_limit_s=30.0, threads=2))
-    assert s.solver == "rolling" and s.extras["windows"] == 4 and exact.status == "optimal"
+    windows = windows_of(problem, shipped["options"]["window_s"])
+    assert s.solver == "rolling" and exact.status == "optimal" and windows > 1
+    assert s.extras["windows"] == windows and s.extras["inner"] == shipped["options"]["inner"]
+    assert s.extras["window_time_limit_s"] == pytest.approx(shipped["time_limit_s"] / windows) and s.seed == shipped["seed"]
+    # the options the file sets are also the solver's defaults (900 s, cpsat): what the loader read of them
+    loaded = load_profile("rolling")
+    assert (loaded.solver, loaded.time_limit_s, loaded.threads, loaded.seed, dict(loaded.options)) == (
+        shipped["solver"], shipped["time_limit_s"], shipped["threads"], shipped["seed"], shipped["options"])
     assert_verified(problem, s)
     assert s.bound <= exact.objective + OBJ_TOL <= s.objective + 2 * OBJ_TOL
 

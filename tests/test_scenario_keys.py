@@ -16,8 +16,8 @@ import numpy as np
 import pytest
 from conftest import PAPER_CASE, ROOT
 
-from uamopt import scenario as scenario_module
 from uamopt.cli import main
+from uamopt.scenario import schema as scenario_module
 
 
 @pytest.fixture(scope="module")

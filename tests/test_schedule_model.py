@@ -20,7 +20,7 @@ from uamopt.schedule import (
     violations,
     write_schedule,
 )
-from uamopt.schedule.flights import flightset_to_dict
+from uamopt.schedule.flights_file import flightset_to_dict
 
 
 @pytest.fixture(scope="module")

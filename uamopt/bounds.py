@@ -7,7 +7,7 @@ therefore passes each number through :func:`check_number` against a :class:`Rang
 arithmetic: the comparison of a Python int with the range's bounds is exact whatever its size,
 and it refuses NaN (every comparison with NaN is false) and ±inf (the bounds are finite).
 Integers are also held to int64, so numpy can take them. Scenario keys declare the same ranges in
-their pydantic fields (uamopt/scenario.py, the key table); solver profiles in
+their pydantic fields (uamopt/scenario/schema.py, the key table); solver profiles in
 uamopt/solvers/options.py.
 
 The ranges are what a quantity can mean, not what a run can afford: how much memory a grid or a

@@ -142,7 +142,7 @@ def load_flights(path: str | Path, scenario=None, grid=None, network=None) -> Fl
     """The :class:`~uamopt.schedule.flights.FlightSet` of ``flights.json`` (validated)."""
     expect_path(path, "path", "load_flights")
 
-    from uamopt.schedule.flights import load_flights as load
+    from uamopt.schedule.flights_file import load_flights as load
 
     return load(_file(path, "flights.json"), scenario, grid, network)
 

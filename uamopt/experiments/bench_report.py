@@ -129,7 +129,7 @@ def bench_markdown(table) -> str:
 def write_bench(out: str | Path, table) -> str:
     """Write bench.csv, bench.md (and performance_profile.png) into ``out``, all or nothing."""
     from uamopt.outputs import staged_output
-    from uamopt.plotting.style import save
+    from uamopt.plotting.output import save
 
     text = bench_markdown(table)
     with staged_output(out) as stage:

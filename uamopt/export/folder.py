@@ -14,7 +14,8 @@ from pathlib import Path
 from uamopt.bounds import parse_error
 from uamopt.errors import InputFileError
 from uamopt.export.frame import LocalFrame, synthetic_frame
-from uamopt.schedule.flights import Flight, FlightSet, load_flights
+from uamopt.schedule.flights import Flight, FlightSet
+from uamopt.schedule.flights_file import load_flights
 from uamopt.schedule.verify import read_schedule_csv
 
 

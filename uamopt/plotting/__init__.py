@@ -28,18 +28,29 @@ function                      draws                                             
 or inline in Jupyter; :mod:`uamopt.plotting.explore`), not a matplotlib Figure.
 
 Importing this package in Jupyter lets a returned Figure display as a PNG without pyplot
-(:func:`uamopt.plotting.style.show_figures_in`). This package imports matplotlib; ``import uamopt`` does not import
+(:func:`uamopt.plotting.output.show_figures_in`). This package imports matplotlib; ``import uamopt`` does not import
 it. The submodules ``risk``, ``tracks``, ``network`` and ``schedule`` are shadowed here by the functions of the same name
-(import from them with ``from uamopt.plotting.tracks import STAGE_STYLE``); shared
-helpers are public in :mod:`uamopt.plotting.style` and :mod:`uamopt.plotting.geometry`.
+(import from them with ``from uamopt.plotting.tracks import STAGE_STYLE``). The helpers the plot
+functions share are public, one job per module, each importing only those above it:
+
+=================================  ===========================================================
+:mod:`uamopt.plotting.style`       constants: resolution, page size, colours, label halo, credit
+:mod:`uamopt.plotting.geometry`    plain numpy: grid layers and windows, track geometry
+:mod:`uamopt.plotting.layout`      figures and axes: the ``ax=`` argument, pages in inches,
+                                   colour-bar axes, title and data credit
+:mod:`uamopt.plotting.draw`        shared drawing on an Axes: risk colours, cells, maps,
+                                   vertiports, log axes, panel letters and titles
+:mod:`uamopt.plotting.output`      :func:`save`, PNG bytes and the Jupyter display
+=================================  ===========================================================
 """
 
 from uamopt.plotting.benchmark import plot_performance_profile as performance_profile
 from uamopt.plotting.explore import explore
 from uamopt.plotting.network import network
+from uamopt.plotting.output import save, show_figures_in
 from uamopt.plotting.risk import risk, risk_components
 from uamopt.plotting.schedule import delays, gantt
-from uamopt.plotting.style import DPI, save, show_figures_in
+from uamopt.plotting.style import DPI
 from uamopt.plotting.sweeps import plot_sweep as sweep
 from uamopt.plotting.tracks import pareto, tracks
 

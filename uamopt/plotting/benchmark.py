@@ -13,7 +13,7 @@ import math
 
 import numpy as np
 
-from uamopt.plotting.style import single_axes
+from uamopt.plotting.layout import single_axes
 
 
 def distance(value: float, best: float) -> float:

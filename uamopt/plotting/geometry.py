@@ -1,17 +1,35 @@
-"""Track geometry the figures need: distance flown, where a detour starts, the unsafe pieces of
-a track, and which tracks are the two directions of one route.
+"""Geometry the figures need: the layer holding an altitude and the columns of a map window;
+distance flown, where a detour starts, the unsafe pieces of a track, and which tracks are the two
+directions of one route.
 
 Plain numpy (no matplotlib), vectorised over waypoints and samples.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 
 import numpy as np
 
 from uamopt.grid.geometry import polyline_pieces
-from uamopt.plotting.style import layer_of
+
+
+def layer_of(field, altitude_m: float) -> int:
+    """Layer index holding ``altitude_m`` (a face goes to the upper layer), clipped to the grid."""
+    g = field.grid
+    return int(np.clip(math.floor(altitude_m / g.cell[2] + 1e-9), 0, g.shape[2] - 1))
+
+
+def window_slices(field, window=None) -> tuple[slice, slice]:
+    """Column slices of the grid covering ``window`` (x0, x1, y0, y1) m with one cell to spare."""
+    g = field.grid
+    if window is None:
+        return slice(0, g.shape[0]), slice(0, g.shape[1])
+    x0, x1, y0, y1 = window[:4]
+    i0, i1 = int(max(math.floor(x0 / g.cell[0]) - 1, 0)), int(min(math.ceil(x1 / g.cell[0]) + 1, g.shape[0]))
+    j0, j1 = int(max(math.floor(y0 / g.cell[1]) - 1, 0)), int(min(math.ceil(y1 / g.cell[1]) + 1, g.shape[1]))
+    return slice(i0, i1), slice(j0, j1)
 
 
 def along_track_m(waypoints: np.ndarray) -> np.ndarray:

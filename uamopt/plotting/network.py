@@ -20,31 +20,18 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 from matplotlib.ticker import MaxNLocator
 
-from uamopt.plotting.geometry import (
-    along_track_m,
-    cruise_altitude_m,
-    pair_directions,
-    point_at,
-    route_waypoints,
-)
-from uamopt.plotting.style import (
-    BAND_GREEN,
-    LEGEND_BELOW,
-    NO_FLY,
+from uamopt.plotting.draw import (
     cell_image,
     draw_vertiports,
-    finish,
-    inch_grid,
-    is_tall,
-    layer_of,
     map_axes,
     no_fly_hatching,
     panel_letter,
     panel_title,
-    panels,
-    root_figure,
     vertiport_points,
 )
+from uamopt.plotting.geometry import along_track_m, cruise_altitude_m, layer_of, pair_directions, point_at, route_waypoints
+from uamopt.plotting.layout import finish, inch_grid, is_tall, panels, root_figure
+from uamopt.plotting.style import BAND_GREEN, LEGEND_BELOW, NO_FLY
 
 SAFE_PALE = "#f7f7f5"  # free cells with R ≤ R_0
 UNSAFE_PALE = "#e3d3c3"  # free cells with R > R_0

@@ -30,6 +30,23 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
+from uamopt.plotting.draw import (
+    cell_image,
+    draw_risk_layer,
+    draw_vertiports,
+    log10,
+    log_axis,
+    map_axes,
+    mark_threshold,
+    outline,
+    panel_letter,
+    panel_title,
+    risk_cmap,
+    risk_norm,
+    vertiport_points,
+)
+from uamopt.plotting.geometry import layer_of
+from uamopt.plotting.layout import colorbar_axes, finish, inch_grid, is_tall, panels
 from uamopt.plotting.style import (
     BAND_GREEN,
     BAND_TEXT,
@@ -42,25 +59,6 @@ from uamopt.plotting.style import (
     OPEN_SPACE,
     ROAD,
     ROAD_OUTLINE_MAX_COLUMNS,
-    cell_image,
-    colorbar_axes,
-    draw_risk_layer,
-    draw_vertiports,
-    finish,
-    inch_grid,
-    is_tall,
-    layer_of,
-    log10,
-    log_axis,
-    map_axes,
-    mark_threshold,
-    outline,
-    panel_letter,
-    panel_title,
-    panels,
-    risk_cmap,
-    risk_norm,
-    vertiport_points,
 )
 
 PROFILE_STYLE = {  # risk term: (label, colour)

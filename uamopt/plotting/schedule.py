@@ -14,7 +14,7 @@ from matplotlib.collections import LineCollection
 from matplotlib.figure import Figure
 from matplotlib.patches import Patch
 
-from uamopt.plotting.style import single_axes
+from uamopt.plotting.layout import single_axes
 
 DELAY_RED = "crimson"
 

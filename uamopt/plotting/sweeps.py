@@ -67,7 +67,7 @@ def _axes(ax, count: int, width: float = 5.2):
     """(figure, axes) from ``ax`` as every plot of uamopt.plotting takes it: None (a new page), a
     Figure or SubFigure (the page laid out in it), one Axes (the first panel only) or one Axes
     per panel."""
-    from uamopt.plotting.style import panels
+    from uamopt.plotting.layout import panels
 
     def layout(page):
         if hasattr(page, "set_layout_engine"):

@@ -27,38 +27,28 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Patch, Rectangle
 from matplotlib.ticker import MaxNLocator
 
-from uamopt.plotting.geometry import (
-    along_track_m,
-    corridor_columns,
-    detour_window,
-    point_at,
-    unsafe_spans,
-)
-from uamopt.plotting.style import (
-    BAND_GREEN,
-    BAND_TEXT,
-    HALO,
-    LEGEND_BELOW,
-    NO_FLY,
-    OBSTACLE_GREY,
-    colorbar_axes,
+from uamopt.plotting.draw import (
     draw_risk_layer,
-    finish,
-    inch_grid,
-    is_tall,
-    layer_of,
     map_axes,
     mark_threshold,
     outline,
     panel_letter,
     panel_title,
-    panels,
     risk_cmap,
     risk_norm,
     runs,
-    single_axes,
+)
+from uamopt.plotting.geometry import (
+    along_track_m,
+    corridor_columns,
+    detour_window,
+    layer_of,
+    point_at,
+    unsafe_spans,
     window_slices,
 )
+from uamopt.plotting.layout import colorbar_axes, finish, inch_grid, is_tall, panels, single_axes
+from uamopt.plotting.style import BAND_GREEN, BAND_TEXT, HALO, LEGEND_BELOW, NO_FLY, OBSTACLE_GREY
 
 DARK_EDGE = [patheffects.withStroke(linewidth=3.4, foreground="#5c4400")]
 WHITE_EDGE = [patheffects.withStroke(linewidth=3.3, foreground="white")]

@@ -13,13 +13,8 @@ The verifier (``uamopt.schedule.verify``) is imported on its own, not from here,
 independent of the model.
 """
 
-from uamopt.schedule.flights import (
-    Flight,
-    FlightSet,
-    check_flightset,
-    load_flights,
-    save_flights,
-)
+from uamopt.schedule.flights import Flight, FlightSet
+from uamopt.schedule.flights_file import check_flightset, load_flights, save_flights
 from uamopt.schedule.model import (
     Schedule,
     SchedulingProblem,

@@ -41,7 +41,8 @@ import numpy as np
 
 from uamopt.errors import UamoptError
 from uamopt.schedule.core import Objective, PairView, pair_view
-from uamopt.schedule.flights import TIME_TOL_S, FlightSet, save_flights
+from uamopt.schedule.flights import TIME_TOL_S, FlightSet
+from uamopt.schedule.flights_file import save_flights
 from uamopt.schedule.occupancy import ConflictTable, conflict_table
 
 if TYPE_CHECKING:

@@ -18,11 +18,11 @@ from uamopt.errors import UamoptError
 from uamopt.schedule.flights import (
     Flight,
     FlightSet,
-    check_flightset,
     round_half_up,
     waypoint_times_s,
     with_vertical_phases,
 )
+from uamopt.schedule.flights_file import check_flightset
 
 if TYPE_CHECKING:
     from uamopt.grid import AirspaceGrid

@@ -59,7 +59,7 @@ from uamopt.errors import UamoptError
 from uamopt.interrupts import quiet_on_interrupt, stopping
 from uamopt.schedule.flights import TIME_TOL_S
 from uamopt.schedule.model import Schedule, SchedulingProblem, Status, make_schedule
-from uamopt.solvers.deadline import interrupt_at
+from uamopt.solvers.highs import interrupt_at, start_solution
 
 if TYPE_CHECKING:
     from uamopt.solvers import SolverProfile
@@ -70,7 +70,7 @@ quiet_on_interrupt("pyomo.core")  # Ctrl-C while a model is built: no "ERROR: Co
 class _OurInterrupt(logging.Filter):
     """Pyomo warns "Received unhandled status=<HighsModelStatus.kInterrupt: 17> from solver HiGHS"
     whenever HiGHS stops by interrupt, and that is always ours: the deadline callback
-    (deadline.py, read as the time limit) or Ctrl-C (read as the interrupt)."""
+    (solvers/highs.py, read as the time limit) or Ctrl-C (read as the interrupt)."""
 
     def filter(self, record: logging.LogRecord) -> bool:
         return "kInterrupt" not in record.getMessage()
@@ -439,7 +439,7 @@ def solve(problem: SchedulingProblem, profile: SolverProfile, extra=None) -> Sch
         _set_mip_start(solver, mip_start(m, problem, *start.decisions))
     stopped: list = []
     if getattr(solver, "_solver_model", None) is not None:  # pyomo 6.10's persistent HiGHS object
-        stopped = interrupt_at(solver._solver_model, t0 + profile.time_limit_s)  # where HiGHS listens (deadline.py)
+        stopped = interrupt_at(solver._solver_model, t0 + profile.time_limit_s)  # where HiGHS listens (solvers/highs.py)
     left = profile.time_limit_s - (time.perf_counter() - t0)
     if left <= 0.05:
         return _start_only(problem, profile, start, t0, f"the time limit ran out while building the MILP ({build_s:.1f} s)")
@@ -467,7 +467,7 @@ def solve(problem: SchedulingProblem, profile: SolverProfile, extra=None) -> Sch
     if tc == TerminationCondition.convergenceCriteriaSatisfied and has_solution:
         status = "optimal"
     elif tc in (TerminationCondition.maxTimeLimit, TerminationCondition.iterationLimit, TerminationCondition.interrupted
-                ) or (stopped and tc == TerminationCondition.unknown):  # our deadline interrupt (deadline.py)
+                ) or (stopped and tc == TerminationCondition.unknown):  # our deadline interrupt (solvers/highs.py)
         status = "time_limit"
     else:
         raise UamoptError(f"HiGHS stopped with {tc.name} ({_model_status(solver)})", f"solver {profile.name or 'highs'}",
@@ -539,7 +539,6 @@ def _set_mip_start(solver, values: dict) -> None:
     """``Highs.setSolution`` on the persistent Pyomo interface's HiGHS model (pyomo 6.10: the column
     of a variable is ``_pyomo_var_to_solver_var_map[id(var)]``). Without that map (another Pyomo
     version) HiGHS starts cold; :func:`no_worse` still guards the result."""
-    import highspy
 
     index = getattr(solver, "_pyomo_var_to_solver_var_map", None)
     highs = getattr(solver, "_solver_model", None)
@@ -551,7 +550,4 @@ def _set_mip_start(solver, values: dict) -> None:
         col = index.get(var_id)
         if col is not None:
             x[col] = value
-    sol = highspy.HighsSolution()
-    sol.col_value = x.tolist()
-    sol.value_valid = True
-    highs.setSolution(sol)
+    highs.setSolution(start_solution(x))

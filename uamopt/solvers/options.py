@@ -137,7 +137,7 @@ def check_options(solver: str, options: Any, name: str) -> None:
 def _check_highs(options: dict, where: str) -> None:
     import highspy
 
-    from uamopt.solvers.deadline import quiet_highs
+    from uamopt.solvers.highs import quiet_highs
 
     h = quiet_highs()
     for key, value in options.items():

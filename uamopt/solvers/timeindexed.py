@@ -77,7 +77,7 @@ from uamopt.errors import UamoptError
 from uamopt.interrupts import stopping
 from uamopt.schedule.flights import TIME_TOL_S
 from uamopt.schedule.model import Schedule, SchedulingProblem, Status, make_schedule
-from uamopt.solvers.deadline import highs_can_start, interrupt_at, quiet_highs
+from uamopt.solvers.highs import highs_can_start, mip_solver, run_mip, start_solution
 from uamopt.solvers.warmstart import Start, no_schedule, no_worse, reduced, warm_start
 
 if TYPE_CHECKING:
@@ -296,14 +296,8 @@ def _highs(model: GridModel, deadline: float, threads: int, seed: int, gap: floa
            presolve: bool = True) -> EngineResult:
     import highspy
 
-    h = quiet_highs()
-    h.resetGlobalScheduler(True)  # HiGHS keeps one thread pool per process: a new thread count needs a new pool
-    h.setOptionValue("output_flag", False)
-    h.setOptionValue("threads", int(threads))
-    h.setOptionValue("random_seed", int(seed))
-    h.setOptionValue("mip_rel_gap", float(gap))
-    if not presolve:  # at 1,000 flights HiGHS's presolve took the whole limit; without it HiGHS finds incumbents fast
-        h.setOptionValue("presolve", "off")
+    # at 1,000 flights HiGHS's presolve took the whole limit; without it HiGHS finds incumbents fast
+    h = mip_solver(threads, seed, gap, presolve)
     n = model.n_cols
     inf = highspy.kHighsInf
     h.addVars(n, np.zeros(n), np.ones(n))
@@ -335,37 +329,18 @@ def _highs(model: GridModel, deadline: float, threads: int, seed: int, gap: floa
         h.addRows(c, np.full(c, -inf), model.cap_rhs, len(model.cap_col), model.cap_ptr[:-1].astype(np.int32),
                   model.cap_col.astype(np.int32), np.ones(len(model.cap_col)))
     if hint is not None:
-        h.setSolution(_solution(highspy, hint))
-    h.setOptionValue("time_limit", _left(deadline))  # what the model's loading left of the limit
-    interrupt_at(h, deadline)  # HiGHS's own limit is not checked everywhere (deadline.py)
-    t0 = time.perf_counter()
-    found: list[float] = []  # times of HiGHS's improving solutions
-    h.cbMipImprovingSolution.subscribe(lambda *_: found.append(time.perf_counter() - t0))
-    with stopping(h.cancelSolve):  # Ctrl-C and SIGTERM stop HiGHS at once
-        run_status = h.run()
-    if run_status == highspy.HighsStatus.kError:
-        raise UamoptError("HiGHS stopped with an error", "solver timeindexed", "rerun with output_flag = true to see why")
-    seconds = time.perf_counter() - t0
-    status = h.getModelStatus()
-    info = h.getInfo()
-    sol = h.getSolution()
-    x = np.array(sol.col_value) if sol.value_valid else None
-    if hint is not None and x is not None and abs(float(model.cost @ x) - info.objective_function_value) > 1e-6 * (
-            1.0 + abs(info.objective_function_value)):  # a solution that is not the one reported: trust neither
+        h.setSolution(start_solution(hint))
+    run = run_mip(h, deadline, "solver timeindexed")  # what the model's loading left of the limit
+    x = run.x
+    if hint is not None and x is not None and abs(float(model.cost @ x) - run.objective) > 1e-6 * (
+            1.0 + abs(run.objective)):  # a solution that is not the one reported: trust neither
         return _highs(model, deadline, threads, seed, gap, None, presolve)
-    proved = status == highspy.HighsModelStatus.kOptimal
-    bound = float(info.mip_dual_bound) if math.isfinite(info.mip_dual_bound) else None
-    if proved and x is not None:
+    bound = run.bound
+    if run.proved and x is not None:
         bound = min(bound, float(model.cost @ np.round(x))) if bound is not None else float(model.cost @ np.round(x))
-    return EngineResult(x=x, bound=bound, proved=proved, termination=h.modelStatusToString(status), seconds=seconds,
-                        first_incumbent_s=found[0] if found else None, best_incumbent_s=found[-1] if found else None)
-
-
-def _solution(highspy, x: np.ndarray):
-    sol = highspy.HighsSolution()
-    sol.col_value = list(map(float, x))
-    sol.value_valid = True
-    return sol
+    return EngineResult(x=x, bound=bound, proved=run.proved, termination=run.termination, seconds=run.seconds,
+                        first_incumbent_s=run.found[0] if run.found else None,
+                        best_incumbent_s=run.found[-1] if run.found else None)
 
 
 def _cpsat(model: GridModel, problem: SchedulingProblem, deadline: float, threads: int, seed: int, gap: float,
@@ -437,7 +412,7 @@ def run_engine(engine: str, model: GridModel, problem: SchedulingProblem, limit_
     deadline = time.perf_counter() + limit_s
     if engine == "highs" and not highs_can_start(model.n_rows, limit_s):
         return EngineResult(x=None, bound=None, proved=False, seconds=0.0,
-                            termination="not run (HiGHS could not start within the limit: deadline.py)")
+                            termination="not run (HiGHS could not start within the limit: solvers/highs.py)")
     if engine == "highs":
         return _highs(model, deadline, threads, seed, gap, hint)
     if engine == "cpsat":
