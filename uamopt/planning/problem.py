@@ -31,7 +31,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import ndimage
 
 from uamopt.errors import UamoptError
 from uamopt.planning.search import SearchProblem
@@ -63,12 +62,15 @@ def box_counts(mask: np.ndarray, half: tuple[int, int, int], outside: bool = Fal
     O(cells), no loop over cells."""
     counts = np.pad(mask.astype(np.int32), [(h, h) for h in half], constant_values=int(outside))
     for axis, h in enumerate(half):
-        running = np.cumsum(counts, axis=axis, dtype=np.int32)
-        width = 2 * h + 1
-        upper = np.take(running, np.arange(width - 1, running.shape[axis]), axis=axis)
-        lower = np.take(running, np.arange(-1, running.shape[axis] - width), axis=axis)
-        lower[(slice(None),) * axis + (0,)] = 0  # the first box starts at the array's start
-        counts = upper - lower
+        np.cumsum(counts, axis=axis, dtype=np.int32, out=counts)  # in place: one grid-sized array
+        width, n = 2 * h + 1, counts.shape[axis]
+
+        def along(start: int, stop: int, axis: int = axis) -> tuple:
+            return (slice(None),) * axis + (slice(start, stop),)
+
+        box = counts[along(width - 1, n)].copy()  # running[i + w − 1] − running[i − 1], running[−1] = 0
+        box[along(1, None)] -= counts[along(0, n - width)]
+        counts = box
     return counts
 
 
@@ -90,8 +92,32 @@ def buffer_shell_count(occupied: np.ndarray, n_s: tuple[int, int, int]) -> np.nd
     return full - box_counts(occupied, inner, outside=True)  # type: ignore[arg-type]
 
 
+def clearance_threshold_sq(cell: tuple[float, float, float], clearance_m: float) -> float | None:
+    """A squared distance θ such that, between cell centres, d ≥ s_min − 10⁻⁹ exactly when d² > θ:
+    the midpoint between the largest squared centre distance below the limit and the least one
+    at or above it, over every integer offset within reach. None when two such values lie too
+    close for float32 to tell apart (then :func:`clearance_ok` uses the float64 transform).
+
+    >>> clearance_threshold_sq((10.0, 10.0, 10.0), 50.0)  # 2400 (e.g. 40, 20, 20) below, 2500 at
+    2450.0
+    """
+    limit = (clearance_m - 1e-9) ** 2
+    axes = [(np.arange(math.ceil(clearance_m / d) + 2) * d) ** 2 for d in cell]
+    values = np.unique((axes[0][:, None, None] + axes[1][None, :, None] + axes[2][None, None, :]).ravel())
+    below, above = values[values < limit], values[values >= limit]
+    lo = float(below[-1]) if len(below) else 0.0
+    hi = float(above[0])
+    if hi - lo <= 1e-5 * hi:  # float32 squared distances carry ~1e-7 relative error: keep well apart
+        return None
+    return 0.5 * (lo + hi)
+
+
 def clearance_ok(building: np.ndarray, cell: tuple[float, float, float], clearance_m: float) -> np.ndarray:
-    """Cells whose centre is at least s_min from the centre of every building cell (Eq. 15)."""
+    """Cells whose centre is at least s_min from the centre of every building cell (Eq. 15).
+
+    The squared distance transform is ``edt``'s (float32, a quarter of scipy's memory, about 2×
+    faster at 10 m cells), compared with :func:`clearance_threshold_sq`'s exact cut, so the mask is
+    the one scipy's float64 transform gives (tests/test_planning_model.py checks the two agree)."""
     if clearance_m <= 0 or not building.any():
         return np.ones(building.shape, dtype=bool)
     if building.all():
@@ -101,8 +127,16 @@ def clearance_ok(building: np.ndarray, cell: tuple[float, float, float], clearan
     top = int(np.flatnonzero(building.any(axis=(0, 1)))[-1])
     below = min(building.shape[2], top + math.ceil(clearance_m / cell[2] - 1e-9))
     ok = np.ones(building.shape, dtype=bool)
-    distance = ndimage.distance_transform_edt(~building[:, :, :below], sampling=cell)
-    ok[:, :, :below] = distance >= clearance_m - 1e-9
+    free = np.ascontiguousarray(~building[:, :, :below])
+    threshold = clearance_threshold_sq(cell, clearance_m)
+    if threshold is None:
+        from scipy import ndimage
+
+        ok[:, :, :below] = ndimage.distance_transform_edt(free, sampling=cell) >= clearance_m - 1e-9
+        return ok
+    import edt
+
+    ok[:, :, :below] = edt.edtsq(free, anisotropy=tuple(float(c) for c in cell), black_border=False, parallel=1) > threshold
     return ok
 
 
