@@ -70,3 +70,25 @@ def test_a_cut_float32_cannot_resolve_falls_back_to_float64():
     one[5, 5, 0] = True
     ok = clearance_ok(one, cell, clearance)
     assert not ok[10, 5, 0] and ok[5, 5, 5]
+
+
+@pytest.mark.parametrize("measure", ["structures", "count", "share"])
+def test_shell_counts_of_the_band_equal_the_whole_grids(measure):
+    """The model counts R(t) (Eq. 35) on the band's layers only, from the layers within reach; in
+    the band it must equal the count over the whole grid (buffer_shell_count, itself checked
+    against a brute force in tests/test_tracks.py), and be 0 outside it."""
+    import uamopt as ua
+    from uamopt.planning.problem import buffer_shell_count
+
+    scenario = ua.load_scenario("paper_case", ["grid.cell=[25,25,10]", f"tracks.buffer_measure={measure!r}"])
+    field = ua.compute_risk(scenario)
+    model = ua.planning_model(scenario, field)
+    occupied = (field.obstacle | field.no_fly) if measure == "structures" else field.unsafe
+    whole = buffer_shell_count(occupied, model.n_s).astype(float)
+    if measure == "share":
+        whole /= float(np.prod(model.n_s) - np.prod([max(n - 2, 0) for n in model.n_s]))
+    band = np.zeros(field.grid.shape[2], dtype=bool)
+    band[field.band_layers()] = True
+    assert 0 < band.sum() < len(band) and model.n_s[2] > 1
+    assert np.array_equal(model.shell_count[:, :, band], whole[:, :, band])
+    assert not model.shell_count[:, :, ~band].any()

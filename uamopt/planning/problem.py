@@ -28,6 +28,7 @@ Readings (docs/readings.md, paper Sec. 5.1):
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass
 
 import numpy as np
@@ -136,7 +137,9 @@ def clearance_ok(building: np.ndarray, cell: tuple[float, float, float], clearan
         return ok
     import edt
 
-    ok[:, :, :below] = edt.edtsq(free, anisotropy=tuple(float(c) for c in cell), black_border=False, parallel=1) > threshold
+    threads = max(1, min(4, os.cpu_count() or 1))  # the same distances whatever the count (separable passes)
+    ok[:, :, :below] = edt.edtsq(free, anisotropy=tuple(float(c) for c in cell), black_border=False,
+                                 parallel=threads) > threshold
     return ok
 
 
@@ -154,7 +157,7 @@ class PlanningModel:
     field: RiskField
     admissible: np.ndarray  # bool (nx, ny, nz)
     risk: np.ndarray  # R used in Eq. 11 (binary or continuous), 0 in inadmissible cells
-    shell_count: np.ndarray  # R(t) of Eq. 35 per cell (tracks.buffer_measure)
+    shell_count: np.ndarray  # R(t) of Eq. 35 per cell of the band (tracks.buffer_measure); 0 outside it
     n_s: tuple[int, int, int]
     c_h: float  # c_h c_e τ, ¥/m
     c_v: float  # c_v c_e τ, ¥/m
@@ -216,7 +219,12 @@ def planning_model(scenario: Scenario, field: RiskField) -> PlanningModel:
     n_s = buffer_cells(grid.cell, s_min)
     measure = scenario.tracks.buffer_measure
     occupied = (field.obstacle | field.no_fly) if measure == "structures" else field.unsafe
-    shell = buffer_shell_count(occupied, n_s).astype(float)
+    shell = np.zeros(grid.shape)
+    layers = field.band_layers()
+    if len(layers):  # only band cells are ever entered: count there, from the layers within reach
+        lo, hi, reach = int(np.min(layers)), int(np.max(layers)) + 1, (n_s[2] - 1) // 2
+        z0, z1 = max(0, lo - reach), min(grid.shape[2], hi + reach)
+        shell[:, :, lo:hi] = buffer_shell_count(occupied[:, :, z0:z1], n_s)[:, :, lo - z0:hi - z0]
     if measure == "share":
         # Variant: the unsafe share of the shell. With the count, the shell holds 26 cells at 50 m
         # but 602 at 10 m, so μ·R(t) grows 23-fold with resolution and outweighs Eq. 10 entirely.
