@@ -97,9 +97,9 @@ def test_the_written_schedule_carries_the_chosen_speed_and_the_verifier_checks_i
 def test_speed_options_are_checked_and_refused_where_they_cannot_act(paper_problem):
     from uamopt.scenario import load_scenario
 
-    with pytest.raises(UamoptError):
+    with pytest.raises(UamoptError, match=r"invalid value 1\.2 for 'schedule\.speed_options'.*less than or equal to 1"):
         load_scenario("models/paper_case.toml", ["schedule.speed_options=[1.2]"])
-    with pytest.raises(UamoptError):
+    with pytest.raises(UamoptError, match=r"invalid value \[\] for 'schedule\.speed_options'.*at least 1 item"):
         load_scenario("models/paper_case.toml", ["schedule.speed_options=[]"])
     problem = speed_problem(crossing(), [0.5, 1.0])
     with pytest.raises(UamoptError, match=r"speed_turnaround|speed_precedence|speed_choice"):
