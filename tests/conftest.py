@@ -14,6 +14,15 @@ PAPER_CASE = ROOT / "models" / "paper_case.toml"
 
 os.environ.setdefault("MPLBACKEND", "Agg")
 
+# Property tests: under CI (CI set, as .ci/run does) the same examples every run, so a red CI can
+# be re-run and reproduced; elsewhere Hypothesis explores new examples each run (and keeps the
+# failing ones in .hypothesis/). HYPOTHESIS_PROFILE=ci derandomises a local run too.
+from hypothesis import settings  # noqa: E402
+
+settings.register_profile("ci", derandomize=True, print_blob=True)
+settings.register_profile("dev", print_blob=True)
+settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE") or ("ci" if os.environ.get("CI") else "dev"))
+
 #: the longest test files (10-60 s each on 2 cores), run first: ``make test``'s two workers take
 #: whole files in collection order, and a long file taken last leaves the other worker idle
 LONGEST_FIRST = ("test_notebooks.py", "test_replay.py", "test_sweep.py", "test_variants.py", "test_output_safety.py",
