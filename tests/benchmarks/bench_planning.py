@@ -115,15 +115,12 @@ def networkx_peer(cell_m: float) -> dict:
 
 def clearance_peer(model) -> dict:
     """(v): the clearance as the model builds it, and scipy's float64 transform on the same mask."""
-    import math
-
     from scipy import ndimage
 
-    from uamopt.planning.problem import building_cells, clearance_ok
+    from uamopt.planning.problem import building_cells, clearance_layers, clearance_ok
 
     building, cell, s_min = building_cells(model.field), model.field.grid.cell, model.scenario.tracks.clearance_m
-    top = int(np.flatnonzero(building.any(axis=(0, 1)))[-1])
-    below = min(building.shape[2], top + math.ceil(s_min / cell[2] - 1e-9))
+    below = clearance_layers(building, cell, s_min)
 
     def best(fn) -> tuple[float, np.ndarray]:
         times, out = [], None

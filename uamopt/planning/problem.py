@@ -113,6 +113,13 @@ def clearance_threshold_sq(cell: tuple[float, float, float], clearance_m: float)
     return 0.5 * (lo + hi)
 
 
+def clearance_layers(building: np.ndarray, cell: tuple[float, float, float], clearance_m: float) -> int:
+    """How many layers from the ground the clearance's distance transform needs: a layer s_min or
+    more above the highest building cell is clear (``building`` holds at least one cell)."""
+    top = int(np.flatnonzero(building.any(axis=(0, 1)))[-1])
+    return min(building.shape[2], top + math.ceil(clearance_m / cell[2] - 1e-9))
+
+
 def clearance_ok(building: np.ndarray, cell: tuple[float, float, float], clearance_m: float) -> np.ndarray:
     """Cells whose centre is at least s_min from the centre of every building cell (Eq. 15).
 
@@ -123,10 +130,9 @@ def clearance_ok(building: np.ndarray, cell: tuple[float, float, float], clearan
         return np.ones(building.shape, dtype=bool)
     if building.all():
         return np.zeros(building.shape, dtype=bool)
-    # a layer s_min or more above the highest building cell is clear: the distance transform (the
-    # planning model's largest cost at fine cells) runs on the layers below it only
-    top = int(np.flatnonzero(building.any(axis=(0, 1)))[-1])
-    below = min(building.shape[2], top + math.ceil(clearance_m / cell[2] - 1e-9))
+    # the distance transform (the planning model's largest cost at fine cells) runs on the layers
+    # below the first clear one only
+    below = clearance_layers(building, cell, clearance_m)
     ok = np.ones(building.shape, dtype=bool)
     free = np.ascontiguousarray(~building[:, :, :below])
     threshold = clearance_threshold_sq(cell, clearance_m)

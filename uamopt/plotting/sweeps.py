@@ -281,6 +281,11 @@ def _altitude(table, key: str, ax):
     return fig
 
 
+def _numbers(value) -> tuple[float, ...]:
+    """A swept list value as its numbers: the table holds lists as their TOML text ("[10.0, 10.0, 10.0]")."""
+    return tuple(float(v) for v in str(value).strip("[]").split(","))
+
+
 def _cell(table, key: str, ax):
     fig, axes = _axes(ax, 4, width=3.4)
     rows = table.drop_duplicates("case")
@@ -290,7 +295,7 @@ def _cell(table, key: str, ax):
     pos = np.arange(len(labels))
     for i, (a, (column, title)) in enumerate(zip(axes, metrics, strict=False)):
         a.bar(pos - 0.2, rows[column].astype(float), width=0.4, label="uamopt")
-        paper = [(table4_row(str(cell).strip("[]").split(",")) or (np.nan,) * 4)[i] for cell in rows[key]]
+        paper = [(table4_row(_numbers(cell)) or (np.nan,) * 4)[i] for cell in rows[key]]
         if np.isfinite(paper).any():
             a.bar(pos + 0.2, paper, width=0.4, label="paper (Table 4)")
         a.set_xticks(pos, [label.replace(".0", "") for label in labels], fontsize=8)
@@ -304,7 +309,7 @@ def _cell(table, key: str, ax):
 def _weights(table, key: str, ax):
     fig, axes = _axes(ax, 1, width=6.0)
     rows = table[table["status"] != "error"].drop_duplicates("case")
-    weights = [tuple(float(v) for v in str(w).strip("[]").split(",")) for w in rows[key]]
+    weights = [_numbers(w) for w in rows[key]]
     order = np.argsort([w[0] for w in weights])
     risk, cost = rows["risk_cost"].to_numpy()[order], rows["transport_cost"].to_numpy()[order]
     axes[0].plot(cost, risk, "-o", color="tab:blue")
