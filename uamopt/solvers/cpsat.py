@@ -39,7 +39,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -209,7 +209,7 @@ class CpsatModel:
     integer scaling of the problem's objective: divide by ``divisor`` (``how`` names the scaling,
     :func:`objective_bound` reads a bound back)."""
 
-    model: Any
+    model: cp_model.CpModel
     operate: list
     delay: list
     per_unit: int
