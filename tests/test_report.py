@@ -4,6 +4,8 @@ Table 4 and Fig. 21 sections show must be the one in the files it claims to summ
 
 from __future__ import annotations
 
+import contextlib
+import io
 import itertools
 import json
 import re
@@ -29,8 +31,18 @@ def reproduced(tmp_path_factory) -> Path:
     args = ["reproduce", str(PAPER_CASE), "--out", str(out)]
     for item in SMALL:
         args += ["--set", item]
-    assert main(args) == 0
+    err = io.StringIO()
+    with contextlib.redirect_stderr(err):  # the progress lines (plain off a terminal)
+        assert main(args) == 0
+    (out.parent / "stderr.txt").write_text(err.getvalue(), encoding="utf-8")
     return out
+
+
+def test_the_progress_counts_every_step(reproduced):
+    """Was: "reproduce: 34/36 steps, 47 s - done" (the buffer variant and the Pareto front never counted)."""
+    lines = [line for line in (reproduced.parent / "stderr.txt").read_text().splitlines() if line.startswith("reproduce: ")]
+    last = re.fullmatch(r"reproduce: (\d+)/(\d+) steps, \d+ s - done", lines[-1])
+    assert last and last.group(1) == last.group(2), lines
 
 
 def sections(report: str) -> dict[str, str]:

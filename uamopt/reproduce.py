@@ -110,8 +110,10 @@ def reproduce(scenario: Scenario, out: str | Path, overrides: list[str] | None =
         other = "count" if scenario.tracks.buffer_measure != "count" else "structures"
         v_scenario, v_model, v_plan, _ = plan_at(scenario.with_overrides([f"tracks.buffer_measure={other}"]), t2,
                                                  field.grid.extent)
+        bar.update(1)
         bar.set_description("pareto front")
         fronts = {flag: weight_sweep(fine_model, origin, destination, 9, buffer=flag) for flag in (False, True)}
+        bar.update(1)
         if figures:
             from uamopt import plotting
 
