@@ -6,6 +6,7 @@ Each case runs in a fresh interpreter (real signals to itself; the test process 
 
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -214,12 +215,15 @@ def test_highs_stopped_at_its_deadline_prints_no_pyomo_warning():
 
 
 SLOW_EXIT = """import sys, threading, time
+import uamopt.cli as cli
+end = cli._end_process
+def announced(code):  # the command is over: only the end of the process is left
+    print("EXITING", flush=True)
+    end(code)
+cli._end_process = announced
+threading.Thread(target=time.sleep, args=(5,)).start()  # a library's worker thread the process waits for
 sys.argv = ["uamopt", *sys.argv[1:]]
-from uamopt.cli import main
-code = main()  # as the console script calls it
-threading.Thread(target=time.sleep, args=(5,)).start()  # a library's worker thread the interpreter waits for
-print("EXITING", flush=True)
-sys.exit(code)
+sys.exit(cli.main())  # as the console script calls it
 """
 
 
@@ -235,11 +239,46 @@ def test_a_signal_during_the_shutdown_of_a_finished_command_keeps_its_exit_code(
                             cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     first = proc.stdout.readline()  # the command's one result line: its work is done
     assert "risk" in first and (out / "summary.json").is_file(), first
-    assert proc.stdout.readline() == "EXITING\n"  # main() has returned: only the shutdown is left
+    assert proc.stdout.readline() == "EXITING\n"  # the command has returned: only the shutdown is left
     proc.send_signal(getattr(signals, sig))
     _stdout, stderr = proc.communicate(timeout=60)
     assert proc.returncode == 0, (proc.returncode, stderr)
     assert "Traceback" not in stderr and "KeyboardInterrupt" not in stderr, stderr
+
+
+TEARDOWN_PROBE = """import atexit, builtins, os
+marks = os.environ["UAMOPT_TEST_MARKS"]
+atexit.register(lambda: open(os.path.join(marks, "atexit"), "w").close())
+class Probe:
+    def __del__(self, open=open, join=os.path.join):  # runs only in the interpreter's teardown
+        open(join(marks, "teardown"), "w").close()
+builtins._uamopt_teardown_probe = Probe()
+"""
+
+
+def test_a_finished_command_runs_the_exit_hooks_and_skips_the_interpreters_teardown(tmp_path):
+    """The console script ends a finished command after the exit hooks, without the teardown in
+    which a library's daemon or native thread re-entering Python aborted the process (CI: ``uamopt
+    risk`` stopped by SIGTERM printed its line, then "Fatal Python error: PyEval_RestoreThread ...
+    Python runtime state: finalizing", exit -6; CPython gh-87135). A ``sitecustomize`` registers an
+    exit hook and an object whose ``__del__`` only the teardown runs; before, both marks appeared."""
+    site, marks, out = tmp_path / "site", tmp_path / "marks", tmp_path / "risk"
+    site.mkdir()
+    marks.mkdir()
+    (site / "sitecustomize.py").write_text(TEARDOWN_PROBE)
+    env = os.environ | {"PYTHONPATH": os.pathsep.join([str(site), *filter(None, [os.environ.get("PYTHONPATH")])]),
+                        "UAMOPT_TEST_MARKS": str(marks)}
+    done = subprocess.run([sys.executable, "-m", "uamopt", "risk", "models/paper_case.toml", "--set",
+                           "grid.cell=[250,250,60]", "--no-figures", "--out", str(out)], cwd=ROOT, env=env,
+                          capture_output=True, text=True, check=False, timeout=300)
+    assert done.returncode == 0 and (out / "summary.json").is_file(), done.stderr
+    assert done.stdout.startswith("risk field: 1,080 cells"), done.stdout  # stdout flushed before the end
+    assert sorted(p.name for p in marks.iterdir()) == ["atexit"], done.stderr
+
+    # the probe can see a teardown: the same interpreter with no uamopt command runs one
+    (marks / "atexit").unlink()
+    subprocess.run([sys.executable, "-c", "pass"], env=env, check=True, timeout=60)
+    assert sorted(p.name for p in marks.iterdir()) == ["atexit", "teardown"]
 
 
 CLUSTER_CUT = """import os, signal, sys, threading
