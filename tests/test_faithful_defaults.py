@@ -88,7 +88,7 @@ def test_buffer_readings_act(model_20m):
     assert float(share.shell_count.max()) <= 1.0 < float(count.shell_count.max())
     priority = _model(20.0, ["tracks.buffer_charge=priority"])
     problem = priority.search_problem("initial")
-    assert not np.any(problem.penalty) and np.array_equal(problem.priority, 100.0 * structures)
+    assert not np.any(problem.entry_penalty()) and np.array_equal(problem.open_priority(), 100.0 * structures)
 
 
 @pytest.mark.parametrize("backend", ["fast", "python"])

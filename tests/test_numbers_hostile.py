@@ -145,7 +145,8 @@ def test_the_default_memory_limit_honours_the_address_space_limit(out):
     """Without grid.memory_limit_gb the guard's default is within ``ulimit -v``: the same grid is refused
     before anything is allocated, naming its size and the limit."""
     run = _limited(["risk", str(PAPER_CASE), "--set", "grid.cell=[2,2,2]", "--out", str(out)], limit_gb=4)
-    line = _one_error_line(run, "a grid of 506,250,000 cells needs about 75.4 GB, more than the limit of")
+    # 120 MiB + 50 B × 506,250,000 cells = 23.7 GiB (uamopt/grid/grid.py, MEMORY_MODEL["risk"])
+    line = _one_error_line(run, "a grid of 506,250,000 cells needs about 23.7 GB, more than the limit of")
     assert float(re.search(r"limit of ([\d.]+) GB", line).group(1)) < 4
     _untouched(out)
 

@@ -39,10 +39,18 @@ def recompute_cell(s: Scenario, vr: float, h: float, cs: float, rho_p: float, l_
     return w1 * r_p + w2 * r_v + w3 * r_u, r_p, r_v, r_u
 
 
-@pytest.fixture(scope="module")
-def npz(paper_run, tmp_path_factory):
+@pytest.fixture(scope="module", params=["kept", "computed on first use"])
+def npz(request, paper_run, tmp_path_factory):
+    """The paper case's risk.npz: from a field that kept its three terms as computed, and from one
+    that did not (``keep_terms=False``, a planning run's field), whose terms ``save_npz`` computes."""
+    field = paper_run.field
+    if request.param != "kept":
+        import uamopt as ua
+
+        field = ua.compute_risk(paper_run.scenario, keep_terms=False)
+        assert field.terms is None  # nothing of the terms' size is held before they are asked for
     path = tmp_path_factory.mktemp("risk") / "risk.npz"
-    paper_run.field.save_npz(path)
+    field.save_npz(path)
     with np.load(path) as data:
         return {k: data[k] for k in data.files}
 

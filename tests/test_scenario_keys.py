@@ -180,13 +180,27 @@ def test_every_scenario_key_is_read(tmp_path, network_file, monkeypatch):
     assert not dead, f"scenario keys never read: {dead}"
 
 
+def test_the_memory_guard_counts_what_each_command_keeps(tmp_path, capsys):
+    """On the paper case's 54,000 cells ``uamopt risk`` needs 120 MiB + 50 B a cell = 0.12 GB and
+    ``uamopt plan`` (numba's and cvxpy's libraries, the planning model, a search) 305 MiB + 28 B a
+    cell = 0.30 GB: under a 0.2 GB limit the first runs and the second is refused before any work."""
+    limit = ["--set", "grid.memory_limit_gb=0.2", "--no-figures"]
+    assert main(["risk", str(PAPER_CASE), *limit, "--out", str(tmp_path / "risk")]) == 0
+    capsys.readouterr()
+    assert main(["plan", str(PAPER_CASE), *limit, "--out", str(tmp_path / "plan")]) == 2
+    assert capsys.readouterr().err == ("error: a grid of 54,000 cells needs about 0.3 GB, more than the limit of 0.2 GB "
+                                       "(grid.cell / grid.extent): use larger cells or a smaller extent, or raise "
+                                       "grid.memory_limit_gb\n")
+    assert not (tmp_path / "plan").exists()
+
+
 @pytest.mark.parametrize(("override", "fragment"), [
     ("grid.cell=[true,true,true]", "must be a number"),
     ("city.seed=true", "valid integer"),
     ('city.seed="7"', "valid integer"),
     ("city.seed=-1", "greater than or equal to 0"),
     ("schedule.plan_seed=-3", "greater than or equal to 0"),
-    ("grid.extent=[2e5,2e5,360]", "more than the limit"),
+    ("grid.extent=[1e6,1e6,360]", "more than the limit"),  # 4.8e9 cells: 224 GB
     ("grid.memory_limit_gb=0.005", "more than the limit of 0.0 GB"),
 ])
 def test_strict_types_and_memory_guard(tmp_path, capsys, override, fragment):

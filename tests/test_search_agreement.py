@@ -36,14 +36,15 @@ P_O, P_D = (300.0, 300.0, 120.0), (2220.0, 4220.0, 120.0)  # Table B.3
 
 
 def path_cost(problem: SearchProblem, path: np.ndarray) -> float:
-    """Σ ω4 ½(R_n + R_m) d + c_h' horizontal + c_v' |vertical| + penalty_m over the moves, from
+    """Σ ω4 ½(R_n + R_m) d + c_h' horizontal + c_v' |vertical| + s_p · penalty_m over the moves, from
     the problem's arrays alone (search.py's module docstring)."""
     cell = np.asarray(problem.cell, dtype=float)
     total = 0.0
     for u, v in itertools.pairwise(map(tuple, path)):
         step = (np.asarray(v) - np.asarray(u)) * cell
-        total += (problem.w_risk * 0.5 * (problem.risk[u] + problem.risk[v]) * math.sqrt(float(step @ step))
-                  + problem.c_h * math.hypot(step[0], step[1]) + problem.c_v * abs(step[2]) + problem.penalty[v])
+        total += (problem.w_risk * 0.5 * (float(problem.risk[u]) + float(problem.risk[v])) * math.sqrt(float(step @ step))
+                  + problem.c_h * math.hypot(step[0], step[1]) + problem.c_v * abs(step[2])
+                  + problem.penalty_scale * float(problem.penalty[v]))
     return total
 
 
@@ -159,7 +160,8 @@ def cost_to_goal(problem: SearchProblem, goal) -> dict:
     def backwards(u, v, data):
         step = (np.asarray(v) - np.asarray(u)) * cell
         transport = problem.c_h * math.hypot(step[0], step[1]) + problem.c_v * abs(step[2])
-        return problem.w_risk * 0.5 * (problem.risk[u] + problem.risk[v]) * data["length"] + transport + problem.penalty[u]
+        return (problem.w_risk * 0.5 * (float(problem.risk[u]) + float(problem.risk[v])) * data["length"] + transport
+                + problem.penalty_scale * float(problem.penalty[u]))
 
     return nx.single_source_dijkstra_path_length(graph, tuple(goal), weight=backwards)
 

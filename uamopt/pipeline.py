@@ -42,9 +42,11 @@ if TYPE_CHECKING:
     from uamopt.solvers import SolverProfile
 
 
-def scenario_grid(scenario: Scenario) -> AirspaceGrid:
+def scenario_grid(scenario: Scenario, *, use: str = "risk") -> AirspaceGrid:
     """The scenario's grid: ``grid.extent`` (default: the city source's extent up to h'_max) in
-    ``grid.cell`` cells, refused before allocation when larger than ``grid.memory_limit_gb``."""
+    ``grid.cell`` cells, refused before allocation when its run (``use``: ``"risk"`` keeps the
+    field's terms, ``"plan"`` does not: :data:`uamopt.grid.grid.MEMORY_MODEL`) would need more than
+    ``grid.memory_limit_gb``."""
     from uamopt.city import source_extent
     from uamopt.grid import build_grid
 
@@ -54,24 +56,26 @@ def scenario_grid(scenario: Scenario) -> AirspaceGrid:
     else:
         ex, ey = source_extent(scenario)
         extent = (ex, ey, scenario.grid.h_max_airspace)
-    return build_grid(extent, scenario.grid.cell, memory_limit_gb=scenario.grid.memory_limit_gb)
+    return build_grid(extent, scenario.grid.cell, memory_limit_gb=scenario.grid.memory_limit_gb, use=use)
 
 
-def compute_risk(scenario: Scenario) -> RiskField:
+def compute_risk(scenario: Scenario, *, keep_terms: bool = True) -> RiskField:
     """Grid, city layers and the risk field of Eqs. 1–9 / A.1–A.9 (Sec. 3, 4.1.1, App. A).
 
     The returned field carries its timings in ``meta["seconds"]`` (city, risk, total) and
-    ``summary()`` gives the risk command's ``summary.json``.
+    ``summary()`` gives the risk command's ``summary.json``. With ``keep_terms=False`` the three
+    risk terms are computed again when first used instead of kept (a planning run's memory:
+    :func:`uamopt.risk.risk_field`).
     """
     from uamopt.city import load_city
     from uamopt.risk import risk_field
 
     expect(scenario, Scenario, "scenario", "compute_risk")
     t0 = time.perf_counter()
-    grid = scenario_grid(scenario)
+    grid = scenario_grid(scenario, use="risk" if keep_terms else "plan")
     city = load_city(scenario, grid)
     t1 = time.perf_counter()
-    field = risk_field(scenario, grid, city)
+    field = risk_field(scenario, grid, city, keep_terms=keep_terms)
     t2 = time.perf_counter()
     field.meta["seconds"] = {"city": t1 - t0, "risk": t2 - t1, "total": t2 - t0}
     return field
@@ -200,7 +204,7 @@ def scenario_flights(scenario: Scenario, flights_file=None, network_file=None, s
                            str(flights_file), "flight")
         return flights
     if network is None:
-        network = plan_network(planning_model(scenario, compute_risk(scenario)))
+        network = plan_network(planning_model(scenario, compute_risk(scenario, keep_terms=False)))
     return generate_flights(scenario, network, seed)
 
 

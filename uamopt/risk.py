@@ -162,20 +162,79 @@ class RiskConstants:
 
 
 @dataclass(frozen=True)
+class TermModel:
+    """Eqs. 1–7 and A.1–A.5 reduced to the scalars and column layers they need: one layer's
+    three risk terms on demand (:meth:`layer`). Column terms are computed once: N^P = ρ_P S_e
+    (Eq. 2), 1/(4 c_s) (Eq. 3, inf where c_s = 0) and R^V = λ ρ_V l_r P^V (Eqs. 4–5), which does
+    not depend on altitude."""
+
+    surface_height: np.ndarray  # (nx, ny), m
+    half_cell_z: float  # m
+    lam_people: np.ndarray  # λ N^P per column (Eqs. 1-2)
+    inv4cs: np.ndarray  # 1/(4 c_s) per column
+    risk_v_column: np.ndarray  # R^V per column
+    k_per_m: float
+    half_log_ab: float  # ½ ln(α/β)
+    log_beta_over_half_mg_k: float  # ln β − ln(½ m g / k)
+    root_gk: float  # √(g k)
+    uav_scale: float  # λ ρ_U e_w e_h
+    mean_speed_mps: float  # v_r' (A.6)
+    fuselage_length_m: float  # e_l
+
+    @classmethod
+    def of(cls, scenario: Scenario, grid: AirspaceGrid, city: CityLayers, c: RiskConstants) -> TermModel:
+        r, a = scenario.risk, scenario.aircraft
+        g, lam = r.gravity_mps2, r.failure_rate_per_h
+        with np.errstate(divide="ignore"):
+            inv4cs = np.where(city.shelter > 0, 1.0 / (4.0 * np.where(city.shelter > 0, city.shelter, 1.0)), np.inf)
+        return cls(
+            surface_height=city.surface_height, half_cell_z=0.5 * grid.cell[2],
+            lam_people=lam * (c.crash_area_m2 * city.population_density), inv4cs=inv4cs,
+            risk_v_column=lam * r.traffic_density_per_m * city.road_length * c.vehicle_collision_probability,
+            k_per_m=c.k_per_m, half_log_ab=0.5 * math.log(r.alpha_j / r.beta_j),
+            log_beta_over_half_mg_k=math.log(r.beta_j) - math.log(0.5 * c.mass_kg * g / c.k_per_m),
+            root_gk=math.sqrt(g * c.k_per_m), uav_scale=lam * r.uav_density_per_m3 * a.wingspan_m * a.height_m,
+            mean_speed_mps=c.mean_relative_speed_mps, fuselage_length_m=a.fuselage_length_m,
+        )
+
+    def layer(self, z: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """(R^P, R^V, R^U, obstacle) of the layer centred at altitude ``z``; NaN in obstacle cells."""
+        # h' per cell (docs/readings.md); an obstacle is any cell reaching below the surface.
+        blocked = (z - self.half_cell_z) < self.surface_height - 1e-9
+        height = np.where(blocked, np.nan, z - self.surface_height)
+        decay = np.exp(-2.0 * self.k_per_m * height)  # e^{-2kh'}, shared by A.3 and the fall time
+        with np.errstate(divide="ignore", invalid="ignore"):
+            # ln E_imp = ln(½ m g / k) + ln(1 - e^{-2kh'})  (A.1, A.3)
+            log_ratio = (self.log_beta_over_half_mg_k - np.log1p(-decay)) * self.inv4cs
+        log_ratio = np.where(np.isnan(log_ratio) & ~blocked, 0.0, log_ratio)  # c_s = 0 and E = β
+        risk_p = self.lam_people * expit(-(self.half_log_ab + log_ratio))  # Eqs. 1 and 3
+        risk_v = np.where(blocked, np.nan, self.risk_v_column)
+        with np.errstate(invalid="ignore"):
+            t_fall = (self.k_per_m * height + np.log1p(np.sqrt(1.0 - decay))) / self.root_gk
+        risk_u = self.uav_scale * (self.mean_speed_mps * t_fall + self.fuselage_length_m)  # A.4-A.5
+        return risk_p, risk_v, risk_u, blocked
+
+
+TERMS = ("risk_P", "risk_V", "risk_U")
+
+
+@dataclass(frozen=True)
 class RiskField:
     """The risk field on the grid. 3-D arrays have shape (nx, ny, nz).
 
     ``risk`` is Eq. 8 and ``risk_P``, ``risk_V``, ``risk_U`` its terms (per flight hour; NaN in
     obstacle cells); ``unsafe`` is Eq. 9 (risk > R_0, obstacle or no-fly); ``obstacle`` marks
     cells inside or below a building.
+
+    The terms are kept as computed (``risk_field(..., keep_terms=True)``, the default, and a
+    loaded ``risk.npz``) or else computed on first use from ``term_model``, all three in one pass,
+    and kept from then on: the planner needs only ``risk`` and ``unsafe``, and at 5 m cells the
+    three float64 terms are 0.78 GB of a plan's memory.
     """
 
     grid: AirspaceGrid
     city: CityLayers
     risk: np.ndarray
-    risk_P: np.ndarray
-    risk_V: np.ndarray
-    risk_U: np.ndarray
     unsafe: np.ndarray
     obstacle: np.ndarray
     band: tuple[float, float]
@@ -183,6 +242,34 @@ class RiskField:
     threshold: float
     seconds: float = 0.0
     meta: dict = field(default_factory=dict)
+    terms: dict[str, np.ndarray] | None = field(default=None, repr=False, compare=False)
+    term_model: TermModel | None = field(default=None, repr=False, compare=False)
+
+    def _terms(self) -> dict[str, np.ndarray]:
+        if self.terms is None:
+            if self.term_model is None:
+                raise ValueError("this risk field holds neither its terms nor the model to compute them")
+            computed = {name: np.empty(self.grid.shape) for name in TERMS}
+            for k, z in enumerate(self.grid.z):
+                for name, values in zip(TERMS, self.term_model.layer(z)[:3], strict=True):
+                    computed[name][:, :, k] = values
+            object.__setattr__(self, "terms", computed)  # a cache of what the field already defines
+        return self.terms  # type: ignore[return-value]
+
+    @property
+    def risk_P(self) -> np.ndarray:
+        """R^P (Eqs. 1–3), the ground-impact term, per flight hour."""
+        return self._terms()["risk_P"]
+
+    @property
+    def risk_V(self) -> np.ndarray:
+        """R^V (Eqs. 4–5), the road-vehicle term, per flight hour."""
+        return self._terms()["risk_V"]
+
+    @property
+    def risk_U(self) -> np.ndarray:
+        """R^U (Eqs. 6–7, A.4–A.9), the mid-air term, per flight hour."""
+        return self._terms()["risk_U"]
 
     @property
     def no_fly(self) -> np.ndarray:
@@ -245,9 +332,12 @@ class RiskField:
             n = int(of.sum())
             return float(mask[of].sum() / n) if n else 0.0
 
-        with np.errstate(invalid="ignore"):
-            road_driven = (w[1] * self.risk_V > self.threshold) & free
-        risk_free = self.risk[free]
+        if self.term_model is not None:  # R^V is a column term: no 3-D temporary
+            road_driven = (w[1] * self.term_model.risk_v_column > self.threshold)[:, :, None] & free
+        else:
+            with np.errstate(invalid="ignore"):
+                road_driven = (w[1] * self.risk_V > self.threshold) & free
+        risk_free = self.risk[free]  # a copy: the median below may reorder it
         c = self.constants
         return {
             "scenario": self.meta.get("scenario", ""),
@@ -272,7 +362,7 @@ class RiskField:
             "risk_per_flight_hour": {
                 "threshold_R0": self.threshold,
                 "min": float(risk_free.min()) if risk_free.size else None,
-                "median": float(np.median(risk_free)) if risk_free.size else None,
+                "median": float(np.median(risk_free, overwrite_input=True)) if risk_free.size else None,
                 "max": float(risk_free.max()) if risk_free.size else None,
             },
             "constants": {
@@ -288,7 +378,7 @@ class RiskField:
         }
 
 
-def risk_field(scenario: Scenario, grid: AirspaceGrid, city: CityLayers) -> RiskField:
+def risk_field(scenario: Scenario, grid: AirspaceGrid, city: CityLayers, *, keep_terms: bool = True) -> RiskField:
     """Compute Eqs. 1–9 for every cell of ``grid`` over ``city``.
 
     Parameters
@@ -299,6 +389,9 @@ def risk_field(scenario: Scenario, grid: AirspaceGrid, city: CityLayers) -> Risk
         The cells.
     city : CityLayers
         Column layers on ``grid``'s footprint.
+    keep_terms : bool
+        Keep R^P, R^V and R^U as computed (three float64 arrays the size of the grid); with
+        False they are computed again on first use (the planner never uses them).
 
     Returns
     -------
@@ -318,52 +411,31 @@ def risk_field(scenario: Scenario, grid: AirspaceGrid, city: CityLayers) -> Risk
     (False, True)
     """
     started = time.perf_counter()
-    r, c, a = scenario.risk, RiskConstants.from_scenario(scenario), scenario.aircraft
-    g, lam = r.gravity_mps2, r.failure_rate_per_h
+    r, c = scenario.risk, RiskConstants.from_scenario(scenario)
     w1, w2, w3 = r.weights
     shape = grid.shape
-    risk, risk_p, risk_v, risk_u = (np.empty(shape) for _ in range(4))
+    model = TermModel.of(scenario, grid, city, c)
+    risk = np.empty(shape)
+    terms = {name: np.empty(shape) for name in TERMS} if keep_terms else None
     unsafe = np.empty(shape, dtype=bool)
     obstacle = np.empty(shape, dtype=bool)
-
-    # Column terms, computed once: N^P = ρ_P S_e (Eq. 2), 1/(4 c_s) (Eq. 3, inf where c_s = 0),
-    # and R^V = λ ρ_V l_r P^V (Eqs. 4-5), which does not depend on altitude.
-    people_per_crash = c.crash_area_m2 * city.population_density
-    with np.errstate(divide="ignore"):
-        inv4cs = np.where(city.shelter > 0, 1.0 / (4.0 * np.where(city.shelter > 0, city.shelter, 1.0)), np.inf)
-    risk_v_col = lam * r.traffic_density_per_m * city.road_length * c.vehicle_collision_probability
-    half_log_ab = 0.5 * math.log(r.alpha_j / r.beta_j)
-    log_half_m_g_over_k = math.log(0.5 * c.mass_kg * g / c.k_per_m)
-    uav_scale = lam * r.uav_density_per_m3 * a.wingspan_m * a.height_m
-    root_gk = math.sqrt(g * c.k_per_m)
 
     # One layer at a time: every operation is vectorised over the layer's columns, and the
     # temporaries stay the size of one layer (memory ~ outputs only, even at 5 m cells).
     for k, z in enumerate(grid.z):
-        # h' per cell (docs/readings.md); an obstacle is any cell reaching below the surface.
-        blocked = (z - 0.5 * grid.cell[2]) < city.surface_height - 1e-9
-        height = np.where(blocked, np.nan, z - city.surface_height)
-        decay = np.exp(-2.0 * c.k_per_m * height)  # e^{-2kh'}, shared by A.3 and the fall time
-        with np.errstate(divide="ignore", invalid="ignore"):
-            # ln E_imp = ln(½ m g / k) + ln(1 - e^{-2kh'})  (A.1, A.3)
-            log_ratio = (math.log(r.beta_j) - log_half_m_g_over_k - np.log1p(-decay)) * inv4cs
-        log_ratio = np.where(np.isnan(log_ratio) & ~blocked, 0.0, log_ratio)  # c_s = 0 and E = β
-        p_people = expit(-(half_log_ab + log_ratio))  # Eq. 3
-        risk_p[:, :, k] = lam * people_per_crash * p_people  # Eq. 1
-        risk_v[:, :, k] = np.where(blocked, np.nan, risk_v_col)
-        with np.errstate(invalid="ignore"):
-            t_fall = (c.k_per_m * height + np.log1p(np.sqrt(1.0 - decay))) / root_gk
-        risk_u[:, :, k] = uav_scale * (c.mean_relative_speed_mps * t_fall + a.fuselage_length_m)  # A.4-A.5
-        layer = w1 * risk_p[:, :, k] + w2 * risk_v[:, :, k] + w3 * risk_u[:, :, k]  # Eq. 8
+        risk_p, risk_v, risk_u, blocked = model.layer(z)
+        if terms is not None:
+            terms["risk_P"][:, :, k], terms["risk_V"][:, :, k], terms["risk_U"][:, :, k] = risk_p, risk_v, risk_u
+        layer = w1 * risk_p + w2 * risk_v + w3 * risk_u  # Eq. 8
         risk[:, :, k] = layer
         with np.errstate(invalid="ignore"):
             unsafe[:, :, k] = (layer > r.threshold) | blocked | city.no_fly  # Eq. 9
         obstacle[:, :, k] = blocked
     return RiskField(
-        grid=grid, city=city, risk=risk, risk_P=risk_p, risk_V=risk_v, risk_U=risk_u,
-        unsafe=unsafe, obstacle=obstacle, band=altitude_band(scenario), constants=c,
+        grid=grid, city=city, risk=risk, unsafe=unsafe, obstacle=obstacle, band=altitude_band(scenario), constants=c,
         threshold=r.threshold, seconds=time.perf_counter() - started,
         meta={"scenario": scenario.name, "weights": tuple(r.weights), "inputs": field_inputs(scenario)},
+        terms=terms, term_model=model,
     )
 
 

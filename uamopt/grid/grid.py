@@ -135,10 +135,15 @@ def altitude_band(scenario: Scenario) -> tuple[float, float]:
     return low, high
 
 
-#: Peak memory of a run per grid cell, bytes: the risk field, the planning model and the search's
-#: arrays (measured: `uamopt plan` at 10 m cells peaks at 0.59 GB for 4.05 M cells, 146 B/cell;
-#: at 5 m 2.85 GB for 32.4 M cells), with a margin.
-BYTES_PER_CELL = 160
+#: Peak memory of a run, bytes = fixed + per cell × cells, for what the run keeps of the field:
+#: ``"risk"``, the risk field with its three terms (``uamopt risk``, ``ua.compute_risk``); ``"plan"``,
+#: the field without them, the planning model and one search (``uamopt plan``, ``network``,
+#: ``reproduce``'s track stages). The fixed part is the interpreter, the libraries (numba's and
+#: cvxpy's for a plan) and the city. Fitted on the peak RSS of the whole command, paper case,
+#: ``--no-figures``, at 10 m and 5 m cells (4.05 M and 32.4 M cells; tests/benchmarks/bench_planning.py
+#: row (vi) prints each estimate beside its measured peak): ``plan`` 0.40 and 1.10 GB, ``risk`` 0.30
+#: and 1.55 GB; the per-cell parts are rounded up, so the estimates lie 1-5 % above the peaks.
+MEMORY_MODEL = {"risk": (120 * 2**20, 50), "plan": (305 * 2**20, 28)}
 
 
 def memory_limit_bytes(limit_gb: float | None = None) -> int:
@@ -181,13 +186,24 @@ def gigabytes(n_bytes: float) -> str:
     return f"{gb:.1f}" if gb < 1e6 else f"{gb:.3g}"
 
 
-def check_memory(cell, extent, limit_bytes: int) -> None:
-    """Refuse a grid whose run would need more than ``limit_bytes``, before anything is allocated.
-    The count is a float, so a tiny cell in a large extent (1e300 cells) is refused, not an overflow."""
+def memory_estimate(cells: float, use: str = "risk") -> float:
+    """The peak memory, bytes, of a run on a grid of ``cells`` cells (:data:`MEMORY_MODEL`).
+
+    >>> round(memory_estimate(32_400_000, "plan") / 2**30, 2)  # the paper case at 5 m cells
+    1.14
+    """
+    fixed, per_cell = MEMORY_MODEL[use]
+    return fixed + per_cell * cells
+
+
+def check_memory(cell, extent, limit_bytes: int, use: str = "risk") -> None:
+    """Refuse a grid whose run (``use``: :data:`MEMORY_MODEL`) would need more than ``limit_bytes``,
+    before anything is allocated. The count is a float, so a tiny cell in a large extent (1e300
+    cells) is refused, not an overflow."""
     cells = 1.0
     for e, c in zip(extent, cell, strict=False):
         cells *= max(math.floor(e / c + 1e-9), 0) if math.isfinite(e / c) else math.inf
-    need = cells * BYTES_PER_CELL
+    need = memory_estimate(cells, use)
     if need > limit_bytes:
         count = f"{int(cells):,}" if cells < 1e15 else f"{cells:.3g}"
         raise GridError(
@@ -207,7 +223,7 @@ def file_grid(extent, cell, memory_limit_gb: float | None, source: str) -> Airsp
                              "give 'cell' as the tracks were planned (e.g. [50, 50, 30]) or raise grid.memory_limit_gb") from None
 
 
-def build_grid(extent, cell, *, memory_limit_gb: float | None = None) -> AirspaceGrid:
+def build_grid(extent, cell, *, memory_limit_gb: float | None = None, use: str = "risk") -> AirspaceGrid:
     """The grid of whole ``cell``-sized cells inside [0, x_max] × [0, y_max] × [0, z_max] = ``extent``.
 
     The scenario's grid (its extent defaulting to the city source's) is
@@ -216,8 +232,8 @@ def build_grid(extent, cell, *, memory_limit_gb: float | None = None) -> Airspac
     Raises
     ------
     GridError
-        The grid holds no cell, or its run would need more memory than ``memory_limit_gb``
-        (default: 80 % of this machine's memory).
+        The grid holds no cell, or its run (``use``: ``"risk"`` or ``"plan"``, :data:`MEMORY_MODEL`)
+        would need more memory than ``memory_limit_gb`` (default: 80 % of this machine's memory).
 
     Examples
     --------
@@ -230,5 +246,5 @@ def build_grid(extent, cell, *, memory_limit_gb: float | None = None) -> Airspac
     if not (isinstance(extent, (list, tuple)) and len(extent) == 3 and all(Range(0.0, MAX_COORD_M).holds(e) for e in extent)):
         raise GridError(f"the extent must be three sizes (x_max, y_max, z_max) in [0, {MAX_COORD_M:g}] m, got {shown(extent)}",
                         "build_grid(extent=...)", "give e.g. (2500, 4500, 360)")
-    check_memory(cell, extent, memory_limit_bytes(memory_limit_gb))
+    check_memory(cell, extent, memory_limit_bytes(memory_limit_gb), use)
     return AirspaceGrid.from_extent(cell, extent)

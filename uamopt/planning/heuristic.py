@@ -49,10 +49,8 @@ def _plan_view_graph(problem):
     c_h = float(problem.c_h)
     column_ok = passable.any(axis=2)
     # the risk and penalty are charged only where the track may fly: their minima over admissible cells
-    min_risk = np.min(problem.risk, axis=2, where=passable, initial=np.inf)  # no temporary of the grid's size
-    min_penalty = np.min(problem.penalty, axis=2, where=passable, initial=np.inf)
-    min_risk[~column_ok] = 0.0  # columns without an admissible cell have no edges
-    min_penalty[~column_ok] = 0.0
+    min_risk = _column_min(problem.risk, passable, column_ok)
+    min_penalty = problem.penalty_scale * _column_min(problem.penalty, passable, column_ok)
     index = np.arange(nx * ny).reshape(nx, ny)
     sources, targets, weights = [], [], []
     for di in (-1, 0, 1):
@@ -71,6 +69,18 @@ def _plan_view_graph(problem):
     # explicit zero weights stay edges in csgraph's sparse input (a free move is still a move)
     return csr_matrix((np.concatenate(weights), (np.concatenate(sources), np.concatenate(targets))),
                       shape=(nx * ny, nx * ny))
+
+
+def _column_min(values: np.ndarray, passable: np.ndarray, column_ok: np.ndarray) -> np.ndarray:
+    """The least value over each column's admissible cells, float64 ((nx, ny); 0 in columns with
+    none: they have no edges). No temporary of the grid's size; integer arrays too."""
+    values = np.asarray(values)
+    if values.dtype == np.bool_:
+        values = values.view(np.uint8)
+    initial = np.inf if values.dtype.kind == "f" else np.iinfo(values.dtype).max
+    least = np.min(values, axis=2, where=passable, initial=initial).astype(float)
+    least[~column_ok] = 0.0
+    return least
 
 
 def column_bound(problem, goal: tuple[int, int, int], heuristic: str) -> tuple[np.ndarray, float]:

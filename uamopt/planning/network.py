@@ -55,7 +55,7 @@ def direction_layers(model: PlanningModel) -> tuple[int, int]:
 def _confined(model: PlanningModel, k: int) -> PlanningModel:
     mask = np.zeros_like(model.admissible)
     mask[:, :, k] = model.admissible[:, :, k]
-    return dataclasses.replace(model, admissible=mask, risk=np.where(mask, model.risk, 0.0))
+    return dataclasses.replace(model, admissible=mask, risk=np.where(mask, model.risk, np.zeros((), model.risk.dtype)))
 
 
 @dataclass(frozen=True, eq=False)

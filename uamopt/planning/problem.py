@@ -162,8 +162,9 @@ class PlanningModel:
     scenario: Scenario
     field: RiskField
     admissible: np.ndarray  # bool (nx, ny, nz)
-    risk: np.ndarray  # R used in Eq. 11 (binary or continuous), 0 in inadmissible cells
-    shell_count: np.ndarray  # R(t) of Eq. 35 per cell of the band (tracks.buffer_measure); 0 outside it
+    risk: np.ndarray  # R used in Eq. 11, 0 in inadmissible cells: uint8 0/1 (binary) or float64 (continuous)
+    # R(t) of Eq. 35 per cell of the band (tracks.buffer_measure), 0 outside it: uint16/uint32 counts or float64 shares
+    shell_count: np.ndarray
     n_s: tuple[int, int, int]
     c_h: float  # c_h c_e τ, ¥/m
     c_v: float  # c_v c_e τ, ¥/m
@@ -172,19 +173,20 @@ class PlanningModel:
         """``shortest``: transport cost (standard A*), risk only breaking ties between equally cheap
         tracks (weight ``SHORTEST_TIE_BREAK`` ¥ per risky metre, far below any difference in
         transport cost between two grid paths); ``initial``: Eqs. 10–13 plus μ·R(t)."""
+        # μ·R(t) as the shell counts and μ (penalty_scale): no grid-sized array is made per stage
         w_risk, w_transport = self.scenario.tracks.weights
         if stage == "shortest":
-            zero = np.zeros(self.admissible.shape)
-            return SearchProblem(self.admissible, self.risk, zero, self.field.grid.cell, SHORTEST_TIE_BREAK,
-                                 self.c_h, self.c_v)
+            return SearchProblem(self.admissible, self.risk, self.shell_count, self.field.grid.cell, SHORTEST_TIE_BREAK,
+                                 self.c_h, self.c_v, penalty_scale=0.0)
         if stage != "initial":
             raise ValueError(f"stage must be 'shortest' or 'initial', got {stage!r}")
-        penalty = self.scenario.tracks.buffer_penalty * self.shell_count
+        mu = float(self.scenario.tracks.buffer_penalty)
         if self.scenario.tracks.buffer_charge == "priority":
-            return SearchProblem(self.admissible, self.risk, np.zeros(penalty.shape), self.field.grid.cell, w_risk,
-                                 w_transport * self.c_h, w_transport * self.c_v, priority=penalty)
-        return SearchProblem(self.admissible, self.risk, penalty, self.field.grid.cell, w_risk,
-                             w_transport * self.c_h, w_transport * self.c_v)
+            return SearchProblem(self.admissible, self.risk, self.shell_count, self.field.grid.cell, w_risk,
+                                 w_transport * self.c_h, w_transport * self.c_v, priority=self.shell_count,
+                                 penalty_scale=0.0, priority_scale=mu)
+        return SearchProblem(self.admissible, self.risk, self.shell_count, self.field.grid.cell, w_risk,
+                             w_transport * self.c_h, w_transport * self.c_v, penalty_scale=mu)
 
 
 def check_aircraft_limits(scenario: Scenario) -> None:
@@ -217,15 +219,16 @@ def planning_model(scenario: Scenario, field: RiskField) -> PlanningModel:
     in_band[field.band_layers()] = True
     admissible = ~(field.obstacle | field.no_fly) & in_band[None, None, :]
     admissible &= clearance_ok(building_cells(field), grid.cell, s_min)
-    if scenario.tracks.risk_model == "binary":
-        risk = field.unsafe.astype(float)
+    if scenario.tracks.risk_model == "binary":  # 0/1 as uint8: an eighth of float64's memory, the same costs
+        risk = (field.unsafe & admissible).view(np.uint8)
     else:
-        risk = np.nan_to_num(field.risk, nan=0.0)
-    risk = np.where(admissible, risk, 0.0)
+        risk = np.where(admissible, np.nan_to_num(field.risk, nan=0.0), 0.0)
     n_s = buffer_cells(grid.cell, s_min)
     measure = scenario.tracks.buffer_measure
     occupied = (field.obstacle | field.no_fly) if measure == "structures" else field.unsafe
-    shell = np.zeros(grid.shape)
+    inner = [max(n - 2, 0) for n in n_s]
+    shell_cells = int(np.prod(n_s) - np.prod(inner))  # the most a count can be
+    shell = np.zeros(grid.shape, dtype=np.uint16 if shell_cells < 2**16 else np.uint32)
     layers = field.band_layers()
     if len(layers):  # only band cells are ever entered: count there, from the layers within reach
         lo, hi, reach = int(np.min(layers)), int(np.max(layers)) + 1, (n_s[2] - 1) // 2
@@ -234,7 +237,6 @@ def planning_model(scenario: Scenario, field: RiskField) -> PlanningModel:
     if measure == "share":
         # Variant: the unsafe share of the shell. With the count, the shell holds 26 cells at 50 m
         # but 602 at 10 m, so μ·R(t) grows 23-fold with resolution and outweighs Eq. 10 entirely.
-        inner = [max(n - 2, 0) for n in n_s]
-        shell /= float(np.prod(n_s) - np.prod(inner))
+        shell = shell / float(shell_cells)
     c_h, c_v = transport_rates(scenario)
     return PlanningModel(scenario, field, admissible, risk, shell, n_s, c_h, c_v)

@@ -2,12 +2,17 @@
 
 The move n → m between 26-neighbour cells (docs/readings.md) costs
 
-    w_risk · ½(R_n + R_m) · d  +  c_h' · horizontal  +  c_v' · |vertical|  +  penalty_m
+    w_risk · ½(R_n + R_m) · d  +  c_h' · horizontal  +  c_v' · |vertical|  +  s_p · penalty_m
 
 where d is the centre distance, c_h' = ω5 c_h c_e τ(m_p) and c_v' = ω5 c_v c_e τ(m_p) fold Eq. 12's
-constants, w_risk = ω4 (Eqs. 10–11) and penalty_m = μ·R(t_m) is the safety-buffer term (Eq. 35).
-An optional ``priority`` array is added to a cell's open-list key only (φ′ of Eq. 34 without
-carrying the term along the path): the search is then guided, not optimal, for that term.
+constants, w_risk = ω4 (Eqs. 10–11) and s_p · penalty_m = μ·R(t_m) is the safety-buffer term
+(Eq. 35): the planning model passes its shell counts R(t) and s_p = μ (``penalty_scale``), so no
+grid-sized product is ever made. An optional ``priority`` array, times ``priority_scale``, is
+added to a cell's open-list key only (φ′ of Eq. 34 without carrying the term along the path): the
+search is then guided, not optimal, for that term.
+
+The arrays may be integer (the binary risk as uint8 0/1, shell counts as uint16): every product
+is taken in float64, so the costs are those of float64 arrays of the same values, bit for bit.
 A move may not cut the corner of an impassable cell: every cell of its bounding box must be
 passable.
 
@@ -46,17 +51,29 @@ class SearchProblem:
     """A grid search instance. Arrays have shape (nx, ny, nz); costs as in the module docstring."""
 
     passable: np.ndarray  # bool
-    risk: np.ndarray  # float, R of Eq. 11 per cell (0 where unused)
-    penalty: np.ndarray  # float, μ·R(t) charged on entering a cell
+    risk: np.ndarray  # float or integer, R of Eq. 11 per cell (0 where unused)
+    penalty: np.ndarray  # float or integer; penalty_scale · penalty is charged on entering a cell (μ·R(t))
     cell: tuple[float, float, float]
     w_risk: float  # ω4
     c_h: float  # ω5 · c_h · c_e · τ, ¥ per horizontal metre (or 1 for plain distance)
     c_v: float  # ω5 · c_v · c_e · τ, ¥ per vertical metre
-    priority: np.ndarray | None = None  # float, added to a cell's open-list key only (not to its cost)
+    priority: np.ndarray | None = None  # times priority_scale, added to a cell's open-list key only (not to its cost)
+    penalty_scale: float = 1.0
+    priority_scale: float = 1.0
 
     @property
     def shape(self) -> tuple[int, int, int]:
         return self.passable.shape  # type: ignore[return-value]
+
+    def entry_penalty(self) -> np.ndarray:
+        """The cost of entering each cell, ``penalty_scale · penalty``, as float64 (a grid-sized array)."""
+        return self.penalty_scale * np.asarray(self.penalty, dtype=float)
+
+    def open_priority(self) -> np.ndarray:
+        """The open-list term of each cell, ``priority_scale · priority`` (zeros without one), as float64."""
+        if self.priority is None:
+            return np.zeros(self.shape)
+        return self.priority_scale * np.asarray(self.priority, dtype=float)
 
 
 @dataclass(frozen=True)
@@ -155,11 +172,11 @@ def _heap_pop(keys, nodes, size):
 
 
 @_compiled
-def _astar_numba(passable, risk, penalty, priority, nx, ny, nz, w_risk, start, goal, column_h, vertical_h,
-                 offsets, corners, counts, lengths, transports):
+def _astar_numba(passable, risk, penalty, penalty_scale, priority, priority_scale, nx, ny, nz, w_risk, start, goal,
+                 column_h, vertical_h, offsets, corners, counts, lengths, transports):
     n_cells = nx * ny * nz
     g = np.full(n_cells, np.inf)
-    parent = np.full(n_cells, -1, dtype=np.int64)
+    parent = np.full(n_cells, -1, dtype=np.int32)  # the caller checks n_cells < 2**31
     closed = np.zeros(n_cells, dtype=np.bool_)
     keys = np.empty(1024, dtype=np.float64)
     nodes = np.empty(1024, dtype=np.int64)
@@ -196,12 +213,14 @@ def _astar_numba(passable, risk, penalty, priority, nx, ny, nz, w_risk, start, g
             h = column_h[vi * ny + vj]
             if h == np.inf:  # the goal is out of reach from this column even in the relaxation
                 continue
-            cand = gu + w_risk * 0.5 * (risk[u] + risk[v]) * lengths[n] + transports[n] + penalty[v]
+            # float64 throughout: an integer or float32 array's value converts exactly
+            cand = (gu + w_risk * 0.5 * (np.float64(risk[u]) + np.float64(risk[v])) * lengths[n] + transports[n]
+                    + penalty_scale * np.float64(penalty[v]))
             if cand < g[v]:
                 g[v] = cand
                 parent[v] = u
                 h += vertical_h * abs(vk - gk)
-                keys, nodes, size = _heap_push(keys, nodes, size, cand + h + priority[v], v)
+                keys, nodes, size = _heap_push(keys, nodes, size, cand + h + priority_scale * np.float64(priority[v]), v)
     return g[goal], parent, expansions
 
 
@@ -212,24 +231,66 @@ def _path_from_parents(parent: np.ndarray, start: int, goal: int, shape) -> np.n
     return np.column_stack(np.unravel_index(np.asarray(path[::-1]), shape))
 
 
-def _priority(problem: SearchProblem) -> np.ndarray:
-    if problem.priority is None:
-        return np.zeros(problem.shape)
-    return np.ascontiguousarray(problem.priority, dtype=float)
+#: the array types the compiled search takes as they are (any other is converted to float64)
+_KERNEL_TYPES = (np.dtype(np.float64), np.dtype(np.uint8), np.dtype(np.uint16), np.dtype(np.uint32))
+
+
+def _flat(values: np.ndarray) -> np.ndarray:
+    """``values`` as the compiled search reads them: flat, C order, and of a type in
+    :data:`_KERNEL_TYPES` (no copy when it already is; a bool array is viewed as uint8)."""
+    values = np.asarray(values)
+    if values.dtype == np.bool_:
+        values = np.ascontiguousarray(values).view(np.uint8)
+    elif values.dtype not in _KERNEL_TYPES:
+        values = values.astype(float)
+    return np.ascontiguousarray(values).ravel()
+
+
+def _layer_slab(problem: SearchProblem) -> tuple[int, int]:
+    """The layers [k0, k1) the compiled search runs on: those from the lowest to the highest with a
+    passable cell (no move enters or cuts a corner of an impassable layer), when copying them
+    costs less memory than the search's own arrays (13 bytes a cell) over the layers left out;
+    else every layer."""
+    nz = problem.shape[2]
+    layers = np.flatnonzero(problem.passable.any(axis=(0, 1)))
+    if len(layers) == 0:
+        return 0, nz
+    k0, k1 = int(layers[0]), int(layers[-1]) + 1
+    arrays = [problem.passable, problem.risk, problem.penalty] + ([problem.priority] if problem.priority is not None else [])
+    copied = sum(np.asarray(a).dtype.itemsize for a in arrays) * (k1 - k0)
+    return (k0, k1) if 13 * (nz - (k1 - k0)) > copied else (0, nz)
 
 
 def _fast(problem: SearchProblem, start: int, goal: int, bound: tuple[np.ndarray, float]):
     nx, ny, nz = problem.shape
+    if nx * ny * nz >= 2**31:
+        raise ValueError(f"a grid of {nx * ny * nz:,} cells is beyond the fast search's 2**31 cells")
+    k0, k1 = _layer_slab(problem)
+    slab = (slice(None), slice(None), slice(k0, k1))
+
+    def cut(values):
+        return values if (k0, k1) == (0, nz) else np.asarray(values)[slab]
+
+    def index(flat: int) -> int:  # a cell's index in the slab
+        i, j, k = np.unravel_index(flat, (nx, ny, nz))
+        return int(np.ravel_multi_index((i, j, k - k0), (nx, ny, k1 - k0)))
+
     lengths, transports = move_costs(problem.cell, problem.c_h, problem.c_v)
+    penalty = _flat(cut(problem.penalty))
+    # no priority: the penalty array again, weighted 0 (no grid-sized array of zeros)
+    priority, priority_scale = ((penalty, 0.0) if problem.priority is None
+                                else (_flat(cut(problem.priority)), float(problem.priority_scale)))
     cost, parent, expansions = _astar_numba(
-        np.ascontiguousarray(problem.passable).ravel(), np.ascontiguousarray(problem.risk, dtype=float).ravel(),
-        np.ascontiguousarray(problem.penalty, dtype=float).ravel(), _priority(problem).ravel(), nx, ny, nz,
-        float(problem.w_risk), start, goal, np.ascontiguousarray(bound[0], dtype=float), float(bound[1]),
-        OFFSETS, CORNERS, CORNER_COUNTS, lengths, transports,
+        np.ascontiguousarray(cut(problem.passable)).ravel(), _flat(cut(problem.risk)), penalty,
+        float(problem.penalty_scale), priority, priority_scale, nx, ny, k1 - k0, float(problem.w_risk), index(start),
+        index(goal), np.ascontiguousarray(bound[0], dtype=float), float(bound[1]), OFFSETS, CORNERS, CORNER_COUNTS,
+        lengths, transports,
     )
     if not np.isfinite(cost):
         return None, math.inf, int(expansions)
-    return _path_from_parents(parent, start, goal, problem.shape), float(cost), int(expansions)
+    path = _path_from_parents(parent, index(start), index(goal), (nx, ny, k1 - k0))
+    path[:, 2] += k0
+    return path, float(cost), int(expansions)
 
 
 # --- reference backends -------------------------------------------------------------------------
@@ -237,7 +298,8 @@ def _fast(problem: SearchProblem, start: int, goal: int, bound: tuple[np.ndarray
 
 def _python(problem: SearchProblem, start: int, goal: int, bound: tuple[np.ndarray, float]):
     shape = problem.shape
-    passable, risk, penalty, priority = problem.passable, problem.risk, problem.penalty, _priority(problem)
+    passable, risk = problem.passable, np.asarray(problem.risk, dtype=float)
+    penalty, priority = problem.entry_penalty(), problem.open_priority()
     lengths, transports = move_costs(problem.cell, problem.c_h, problem.c_v)
     goal_c = np.unravel_index(goal, shape)
     start_c = tuple(int(v) for v in np.unravel_index(start, shape))
@@ -286,10 +348,10 @@ def _networkx(problem: SearchProblem, start: int, goal: int, bound: tuple[np.nda
 
     from uamopt.planning.graph import grid_graph
 
-    if problem.priority is not None and np.any(problem.priority):
+    if problem.priority is not None and problem.priority_scale != 0 and np.any(problem.priority):
         raise ValueError("the networkx backend has no open-list priority term; use backend 'fast' or 'python'")
     graph = grid_graph(problem.passable, problem.cell)
-    risk, penalty = problem.risk, problem.penalty
+    risk, penalty = np.asarray(problem.risk, dtype=float), problem.entry_penalty()
     cell = np.asarray(problem.cell)
 
     def weight(u, v, data):
@@ -318,13 +380,15 @@ _WARM: set[str] = set()
 
 def warm_up(backend: str = "fast") -> float:
     """Compile (or load from numba's cache) the ``fast`` search once per process, on a 2-cell grid,
+    for float64 arrays and for the planning model's own (uint8 binary risk, uint16 shell counts),
     so that a stage's reported time is its search, not the compiler. Returns the seconds spent
     (0.0 when already warm or for the uncompiled backends)."""
     if backend != "fast" or backend in _WARM:
         return 0.0
     started = time.perf_counter()
     free, zero = np.ones((2, 1, 1), dtype=bool), np.zeros((2, 1, 1))
-    _fast(SearchProblem(free, zero, zero, (1.0, 1.0, 1.0), 0.0, 1.0, 1.0), 0, 1, (np.zeros(2), 0.0))
+    for risk, penalty in ((zero, zero), (zero.astype(np.uint8), zero.astype(np.uint16))):
+        _fast(SearchProblem(free, risk, penalty, (1.0, 1.0, 1.0), 0.0, 1.0, 1.0), 0, 1, (np.zeros(2), 0.0))
     _WARM.add(backend)
     return time.perf_counter() - started
 
