@@ -227,3 +227,35 @@ def test_relaxed_bound_is_exact_on_one_free_layer(seed, nx_, ny_):
     column_h = plan_view_distance(problem, goal[:2])  # "relaxed" itself falls back to "transport" on one layer
     for (i, j, _), exact in to_goal.items():
         assert column_h[i * ny_ + j] == pytest.approx(exact, rel=REL, abs=1e-12), (i, j)
+
+
+def _fast_with_both_bounds(problem: SearchProblem, start, goal):
+    """The fast search with the relaxed bound settled lazily (as ``grid_search`` runs it) and with
+    scipy's whole-grid table (``plan_view_distance``): (path, cost, expansions) of each."""
+    from uamopt.planning.search import _fast
+
+    s, t = (int(np.ravel_multi_index(tuple(c), problem.shape)) for c in (start, goal))
+    lazy = _fast(problem, s, t, column_bound(problem, goal, "relaxed", lazy=True))
+    whole = _fast(problem, s, t, column_bound(problem, goal, "relaxed"))
+    return lazy, whole
+
+
+def _same_search(lazy, whole) -> None:
+    assert lazy[1] == whole[1] and lazy[2] == whole[2], (lazy[1:], whole[1:])
+    assert (lazy[0] is None and whole[0] is None) or np.array_equal(lazy[0], whole[0])
+
+
+@settings(max_examples=25, deadline=None, derandomize=True)
+@given(random_cities())
+def test_the_lazily_settled_bound_is_scipys(city):
+    """The fast search settles the relaxed bound column by column, only where it reaches (a Dijkstra
+    resumed from the goal column inside the compiled search). Given scipy's whole-grid Dijkstra
+    instead, it must expand the same cells in the same order: the same path, cost and number of
+    expansions; a bound that differed in one column would change the count or the path."""
+    _same_search(*_fast_with_both_bounds(*city))
+
+
+@pytest.mark.parametrize("stage", ["shortest", "initial"])
+def test_the_lazily_settled_bound_is_scipys_on_the_paper_case(paper_cells, stage):
+    model, start, goal = paper_cells
+    _same_search(*_fast_with_both_bounds(model.search_problem(stage), start, goal))

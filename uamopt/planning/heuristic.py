@@ -7,16 +7,21 @@ vertical rate v, so that every backend evaluates it the same way (``search.py``)
 - ``"transport"``: H = c_h'·octile(Δi Δx, Δj Δy) and v = c_v'·Δz, the cheapest transport cost to
   the goal in free space.
 - ``"relaxed"`` (default): H is the exact cost to the goal column in the plan-view relaxation of
-  the grid, and v = c_v'·Δz. The relaxation keeps one node per column (i, j) with an admissible
-  cell and lets a 2-D move between neighbouring columns a, b cost
+  the grid, and v = c_v'·Δz + ρ·(√(Δh² + Δz²) − Δh), where Δh = √(Δx² + Δy²) is the longest
+  horizontal step and ρ = max(0, w_risk · min R), min R the least risk over the whole grid. The
+  relaxation keeps one node per column (i, j) with an admissible cell and lets a 2-D move between
+  neighbouring columns a, b cost
 
       w_risk · ½(min R_a + min R_b) · horizontal  +  c_h' · horizontal  +  min penalty_b,
 
-  the minima over the admissible cells of each column. Every 3-D move costs at least the
-  relaxation of its horizontal part plus c_v'·|vertical| (its centre distance is at least its
-  horizontal length; R and the penalty are at least their column minima; a vertical move
-  projects onto no move at all), so H + v·|Δk| is a lower bound of every path's cost, and,
-  H being a shortest-path distance, it is consistent. It charges what the transport bound
+  the minima over the admissible cells of each column. Every 3-D move with a vertical step costs
+  at least the relaxation of its horizontal part h plus v: R and the penalty are at least their
+  column minima, c_v'·Δz is paid, and its centre distance d exceeds h by √(h² + Δz²) − h, which
+  is least for h = Δh (a vertical move projects onto no move at all and has d − h = Δz, more),
+  each metre of that excess bearing risk ρ at least. So H + v·|Δk| is a lower bound of every
+  path's cost, and, H being a shortest-path distance, it is consistent. ρ is 0 as soon as one
+  cell has no risk; on a uniform risk (the Moving AI voxel maps, ``voxel.py``) it is what lets the
+  bound see a climb. The relaxation charges what the transport bound
   cannot see: a road whose risk fills every admissible layer of its columns must be crossed, and
   it costs the same at every altitude. On the paper case at 10 m cells the relaxed bound at the
   origin equals the optimal Eq. 10 cost (140.37; the transport bound is 14.67), and A* expands
@@ -24,7 +29,9 @@ vertical rate v, so that every backend evaluates it the same way (``search.py``)
 
 H is infinite on columns the goal cannot be reached from even in the relaxation; the search
 skips their cells. The relaxation is solved by ``scipy.sparse.csgraph.dijkstra`` on the reversed
-column graph. Where the admissible cells lie in one layer (the route network's searches, each
+column graph; the fast search runs the same Dijkstra lazily instead (``lazy=True``), settling a
+column when it first needs its H, so that a short query does not pay for the whole grid.
+Where the admissible cells lie in one layer (the route network's searches, each
 confined to its direction's layer), the relaxation is the problem itself: solving it whole
 costs more than A* with the transport bound (at 10 m cells, ``plan_network`` took 6.7 s of CPU
 against 4.9 s), so ``"relaxed"`` falls back to ``"transport"`` there.
@@ -83,8 +90,12 @@ def _column_min(values: np.ndarray, passable: np.ndarray, column_ok: np.ndarray)
     return least
 
 
-def column_bound(problem, goal: tuple[int, int, int], heuristic: str) -> tuple[np.ndarray, float]:
-    """(H, v) of the module docstring for ``goal``: H flat over the columns (index i·ny + j)."""
+def column_bound(problem, goal: tuple[int, int, int], heuristic: str, *,
+                 lazy: bool = False) -> tuple[np.ndarray | None, float]:
+    """(H, v) of the module docstring for ``goal``: H flat over the columns (index i·ny + j).
+
+    With ``lazy``, ``"relaxed"`` returns H = None where it would solve the relaxation whole: the
+    fast search settles it itself, over the columns it reaches only (search.py)."""
     nx, ny, _ = problem.shape
     dx, dy, dz = problem.cell
     gi, gj, _ = (int(v) for v in goal)
@@ -101,7 +112,12 @@ def column_bound(problem, goal: tuple[int, int, int], heuristic: str) -> tuple[n
         raise ValueError(f"heuristic must be one of {list(HEURISTICS)}, got {heuristic!r}")
     if np.count_nonzero(problem.passable.any(axis=(0, 1))) <= 1:
         return column_bound(problem, goal, "transport")
-    return plan_view_distance(problem, (gi, gj)), vertical
+    # ρ of the module docstring: the risk of the excess length of a move with a vertical step
+    least_risk = float(problem.w_risk) * float(np.min(problem.risk)) if problem.risk.size else 0.0
+    if least_risk > 0.0:  # (and not NaN)
+        longest = math.hypot(dx, dy)
+        vertical += least_risk * (math.hypot(longest, dz) - longest)
+    return (None if lazy else plan_view_distance(problem, (gi, gj))), vertical
 
 
 def plan_view_distance(problem, goal_column: tuple[int, int]) -> np.ndarray:

@@ -19,7 +19,11 @@ passable.
 Backends (``backend=``):
 
 - ``"fast"`` (default): A* compiled with numba over the implicit grid (flat arrays; no Python
-  object per cell or edge).
+  object per cell or edge). A query fills its per-cell arrays only where the search reaches
+  (they start as calloc's untouched zero pages), and settles the relaxed bound lazily, a column
+  when the search first needs its H (a reverse-resumable Dijkstra on the plan-view relaxation,
+  Silver 2005; the same values as ``column_bound``'s whole-grid table): a short query costs what
+  it expands, not a pass over the grid.
 - ``"python"``: the same A* in pure Python with ``heapq`` — the paper's algorithm, as a readable
   reference.
 - ``"networkx"``: ``networkx.astar_path`` on the explicit grid graph with the same weights.
@@ -172,56 +176,127 @@ def _heap_pop(keys, nodes, size):
 
 
 @_compiled
+def _column_ok(c, passable, risk, penalty, penalty_scale, nz, info, min_risk, min_penalty):
+    """Whether column ``c`` (index i·ny + j) has an admissible cell; on its first call also its
+    least risk and least ``penalty_scale`` · penalty over those cells (heuristic.py's minima)."""
+    if info[c] == 0:
+        least_risk, least_penalty, ok = np.inf, np.inf, False
+        for k in range(c * nz, (c + 1) * nz):
+            if passable[k]:
+                ok = True
+                least_risk = min(least_risk, np.float64(risk[k]))
+                least_penalty = min(least_penalty, np.float64(penalty[k]))
+        info[c] = 1 if ok else 2
+        min_risk[c] = least_risk if ok else 0.0
+        min_penalty[c] = penalty_scale * least_penalty if ok else 0.0
+    return info[c] == 1
+
+
+@_compiled
+def _settle_column(target, column_h, column_state, keys, nodes, size, passable, risk, penalty, penalty_scale, nx, ny,
+                   nz, w_risk, c_h, plan_steps, info, min_risk, min_penalty):
+    """Resume the plan-view relaxation's Dijkstra, run backwards from the goal column, until column
+    ``target`` is settled (``column_h[target]`` is then heuristic.py's H; infinite when the search
+    runs out first). Only the columns nearer the goal than ``target`` are settled on the way."""
+    while column_state[target] != 2 and size > 0:
+        _, b, size = _heap_pop(keys, nodes, size)
+        if column_state[b] == 2:
+            continue
+        column_state[b] = 2
+        bi, bj = b // ny, b % ny
+        for n in range(plan_steps.shape[0]):
+            ai, aj = bi + int(plan_steps[n, 0]), bj + int(plan_steps[n, 1])
+            if ai < 0 or ai >= nx or aj < 0 or aj >= ny:
+                continue
+            a = ai * ny + aj
+            if column_state[a] == 2 or not _column_ok(a, passable, risk, penalty, penalty_scale, nz, info, min_risk,
+                                                      min_penalty):
+                continue
+            horizontal = plan_steps[n, 2]
+            # the move a -> b of the relaxation, weighed as heuristic.py's _plan_view_graph does
+            cand = column_h[b] + (w_risk * 0.5 * (min_risk[a] + min_risk[b]) * horizontal + c_h * horizontal
+                                  + min_penalty[b])
+            if cand < column_h[a]:
+                column_h[a] = cand
+                column_state[a] = 1
+                keys, nodes, size = _heap_push(keys, nodes, size, cand, a)
+    column_state[target] = 2  # settled, or out of reach (column_h stays infinite)
+    return keys, nodes, size
+
+
+@_compiled
 def _astar_numba(passable, risk, penalty, penalty_scale, priority, priority_scale, nx, ny, nz, w_risk, start, goal,
-                 column_h, vertical_h, offsets, corners, counts, lengths, transports):
+                 column_h, column_state, vertical_h, c_h, plan_steps, state, offsets, flat_offsets, flat_corners,
+                 counts, lengths, transports):
     n_cells = nx * ny * nz
-    g = np.full(n_cells, np.inf)
-    parent = np.full(n_cells, -1, dtype=np.int32)  # the caller checks n_cells < 2**31
-    closed = np.zeros(n_cells, dtype=np.bool_)
+    # g and parent are valid where state > 0 (1 open, 2 closed); state comes zeroed from calloc, so
+    # a query touches the memory of the cells it reaches only, not the grid's
+    g = np.empty(n_cells)
+    parent = np.empty(n_cells, dtype=np.int32)  # the caller checks n_cells < 2**31
     keys = np.empty(1024, dtype=np.float64)
     nodes = np.empty(1024, dtype=np.int64)
     size = 0
+    # the relaxed bound, lazily: a column whose column_state is not 2 is settled on first use
+    info = np.zeros(nx * ny, dtype=np.uint8)
+    min_risk = np.empty(nx * ny)
+    min_penalty = np.empty(nx * ny)
+    column_keys = np.empty(1024, dtype=np.float64)
+    column_nodes = np.empty(1024, dtype=np.int64)
+    column_size = 0
+    goal_column = goal // nz
+    if column_state[goal_column] != 2:
+        _column_ok(goal_column, passable, risk, penalty, penalty_scale, nz, info, min_risk, min_penalty)
+        column_h[goal_column] = 0.0
+        column_state[goal_column] = 1
+        column_keys, column_nodes, column_size = _heap_push(column_keys, column_nodes, column_size, 0.0, goal_column)
     gk = goal % nz
     g[start] = 0.0
+    state[start] = 1
     keys, nodes, size = _heap_push(keys, nodes, size, 0.0, start)
     expansions = 0
     while size > 0:
         _, u, size = _heap_pop(keys, nodes, size)
-        if closed[u]:
+        if state[u] == 2:
             continue
-        closed[u] = True
+        state[u] = 2
         expansions += 1
         if u == goal:
             break
         ui, uj, uk = u // (ny * nz), (u // nz) % ny, u % nz
         gu = g[u]
+        ru = np.float64(risk[u])
         for n in range(26):
             vi, vj, vk = ui + offsets[n, 0], uj + offsets[n, 1], uk + offsets[n, 2]
             if vi < 0 or vi >= nx or vj < 0 or vj >= ny or vk < 0 or vk >= nz:
                 continue
+            v = u + flat_offsets[n]
+            if state[v] == 2 or not passable[v]:
+                continue
             ok = True
-            for c in range(counts[n]):
-                ci, cj, ck = ui + corners[n, c, 0], uj + corners[n, c, 1], uk + corners[n, c, 2]
-                if not passable[(ci * ny + cj) * nz + ck]:
+            for c in range(counts[n] - 1):  # the rest of the box: the target v is its last cell
+                if not passable[u + flat_corners[n, c]]:
                     ok = False
                     break
             if not ok:
                 continue
-            v = (vi * ny + vj) * nz + vk
-            if closed[v]:
-                continue
-            h = column_h[vi * ny + vj]
+            column = vi * ny + vj
+            if column_state[column] != 2:
+                column_keys, column_nodes, column_size = _settle_column(
+                    column, column_h, column_state, column_keys, column_nodes, column_size, passable, risk, penalty,
+                    penalty_scale, nx, ny, nz, w_risk, c_h, plan_steps, info, min_risk, min_penalty)
+            h = column_h[column]
             if h == np.inf:  # the goal is out of reach from this column even in the relaxation
                 continue
             # float64 throughout: an integer or float32 array's value converts exactly
-            cand = (gu + w_risk * 0.5 * (np.float64(risk[u]) + np.float64(risk[v])) * lengths[n] + transports[n]
+            cand = (gu + w_risk * 0.5 * (ru + np.float64(risk[v])) * lengths[n] + transports[n]
                     + penalty_scale * np.float64(penalty[v]))
-            if cand < g[v]:
+            if state[v] == 0 or cand < g[v]:
                 g[v] = cand
                 parent[v] = u
+                state[v] = 1
                 h += vertical_h * abs(vk - gk)
                 keys, nodes, size = _heap_push(keys, nodes, size, cand + h + priority_scale * np.float64(priority[v]), v)
-    return g[goal], parent, expansions
+    return (g[goal] if state[goal] == 2 else np.inf), parent, expansions
 
 
 def _path_from_parents(parent: np.ndarray, start: int, goal: int, shape) -> np.ndarray:
@@ -261,7 +336,20 @@ def _layer_slab(problem: SearchProblem) -> tuple[int, int]:
     return (k0, k1) if 13 * (nz - (k1 - k0)) > copied else (0, nz)
 
 
-def _fast(problem: SearchProblem, start: int, goal: int, bound: tuple[np.ndarray, float]):
+def _flat_moves(ny: int, nz: int) -> tuple[np.ndarray, np.ndarray]:
+    """Per offset: its step in flat cell index (grid (·, ny, nz)), and the steps to its bounding
+    box's cells other than the source, in CORNERS' order (the target, every offset nonzero, last)."""
+    stride = np.array([ny * nz, nz, 1], dtype=np.int64)
+    return OFFSETS @ stride, CORNERS @ stride
+
+
+def _plan_steps(cell: tuple[float, float, float]) -> np.ndarray:
+    """The relaxation's 8 plan-view moves, rows (di, dj, horizontal length)."""
+    dx, dy, _ = cell
+    return np.array([(di, dj, math.hypot(di * dx, dj * dy)) for di in (-1, 0, 1) for dj in (-1, 0, 1) if di or dj])
+
+
+def _fast(problem: SearchProblem, start: int, goal: int, bound: tuple[np.ndarray | None, float]):
     nx, ny, nz = problem.shape
     if nx * ny * nz >= 2**31:
         raise ValueError(f"a grid of {nx * ny * nz:,} cells is beyond the fast search's 2**31 cells")
@@ -280,11 +368,16 @@ def _fast(problem: SearchProblem, start: int, goal: int, bound: tuple[np.ndarray
     # no priority: the penalty array again, weighted 0 (no grid-sized array of zeros)
     priority, priority_scale = ((penalty, 0.0) if problem.priority is None
                                 else (_flat(cut(problem.priority)), float(problem.priority_scale)))
+    if bound[0] is None:  # "relaxed", settled column by column as the search reaches them (heuristic.py)
+        column_h, column_state = np.full(nx * ny, np.inf), np.zeros(nx * ny, dtype=np.uint8)
+    else:
+        column_h, column_state = np.ascontiguousarray(bound[0], dtype=float), np.full(nx * ny, 2, dtype=np.uint8)
     cost, parent, expansions = _astar_numba(
         np.ascontiguousarray(cut(problem.passable)).ravel(), _flat(cut(problem.risk)), penalty,
         float(problem.penalty_scale), priority, priority_scale, nx, ny, k1 - k0, float(problem.w_risk), index(start),
-        index(goal), np.ascontiguousarray(bound[0], dtype=float), float(bound[1]), OFFSETS, CORNERS, CORNER_COUNTS,
-        lengths, transports,
+        index(goal), column_h, column_state, float(bound[1]), float(problem.c_h), _plan_steps(problem.cell),
+        np.zeros(nx * ny * (k1 - k0), dtype=np.uint8), OFFSETS, *_flat_moves(ny, k1 - k0), CORNER_COUNTS, lengths,
+        transports,
     )
     if not np.isfinite(cost):
         return None, math.inf, int(expansions)
@@ -296,7 +389,7 @@ def _fast(problem: SearchProblem, start: int, goal: int, bound: tuple[np.ndarray
 # --- reference backends -------------------------------------------------------------------------
 
 
-def _python(problem: SearchProblem, start: int, goal: int, bound: tuple[np.ndarray, float]):
+def _python(problem: SearchProblem, start: int, goal: int, bound: tuple[np.ndarray | None, float]):
     shape = problem.shape
     passable, risk = problem.passable, np.asarray(problem.risk, dtype=float)
     penalty, priority = problem.entry_penalty(), problem.open_priority()
@@ -304,6 +397,7 @@ def _python(problem: SearchProblem, start: int, goal: int, bound: tuple[np.ndarr
     goal_c = np.unravel_index(goal, shape)
     start_c = tuple(int(v) for v in np.unravel_index(start, shape))
     column_h, vertical_h = bound
+    assert column_h is not None  # whole for every backend but "fast" (grid_search)
 
     def heuristic(v):
         return float(column_h[v[0] * shape[1] + v[1]]) + vertical_h * abs(v[2] - int(goal_c[2]))
@@ -343,7 +437,7 @@ def _python(problem: SearchProblem, start: int, goal: int, bound: tuple[np.ndarr
     return np.asarray(path[::-1], dtype=np.int64), float(g[goal_t]), expansions
 
 
-def _networkx(problem: SearchProblem, start: int, goal: int, bound: tuple[np.ndarray, float]):
+def _networkx(problem: SearchProblem, start: int, goal: int, bound: tuple[np.ndarray | None, float]):
     import networkx as nx
 
     from uamopt.planning.graph import grid_graph
@@ -360,6 +454,7 @@ def _networkx(problem: SearchProblem, start: int, goal: int, bound: tuple[np.nda
         return problem.w_risk * 0.5 * (risk[u] + risk[v]) * data["length"] + transport + penalty[v]
 
     column_h, vertical_h = bound
+    assert column_h is not None  # whole for every backend but "fast" (grid_search)
 
     def heuristic(u, v):  # v is the goal
         return float(column_h[u[0] * problem.shape[1] + u[1]]) + vertical_h * abs(u[2] - v[2])
@@ -437,7 +532,7 @@ def grid_search(problem: SearchProblem, start: tuple[int, int, int], goal: tuple
     s = int(np.ravel_multi_index(tuple(start), problem.shape))
     t = int(np.ravel_multi_index(tuple(goal), problem.shape))
     started = time.perf_counter()
-    bound = column_bound(problem, tuple(goal), heuristic)
+    bound = column_bound(problem, tuple(goal), heuristic, lazy=backend == "fast")
     path, cost, expansions = BACKENDS[backend](problem, s, t, bound)
     seconds = time.perf_counter() - started
     if path is None:
