@@ -71,6 +71,7 @@ def compute_risk(scenario: Scenario, *, keep_terms: bool = True) -> RiskField:
     from uamopt.risk import risk_field
 
     expect(scenario, Scenario, "scenario", "compute_risk")
+    expect(keep_terms, bool, "keep_terms", "compute_risk")
     t0 = time.perf_counter()
     grid = scenario_grid(scenario, use="risk" if keep_terms else "plan")
     city = load_city(scenario, grid)
