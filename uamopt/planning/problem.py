@@ -210,22 +210,37 @@ def building_cells(field: RiskField) -> np.ndarray:
     return field.obstacle & (field.city.building_height > 0)[:, :, None]
 
 
-def planning_model(scenario: Scenario, field: RiskField) -> PlanningModel:
-    """Admissible cells, Eq. 11 risk, the buffer's shell counts and transport rates."""
-    check_aircraft_limits(scenario)
+#: what the arrays of :func:`field_arrays` depend on besides the field: the scenario keys they read
+ARRAY_KEYS = ("tracks.clearance_m", "tracks.risk_model", "tracks.buffer_measure")
+
+
+def field_arrays(scenario: Scenario, field: RiskField) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(admissible, risk, shell_count) of the planning model: Eqs. 14–15, Eq. 11's risk and Eq. 35's
+    R(t), the costly part of the model (the clearance's distance transform, the shell's running sums).
+
+    They depend on the field and the keys of :data:`ARRAY_KEYS` only, not on the weights, μ or the
+    transport rates, so they are kept on the field (the last set built from it) and a second model
+    of the same field (a weight sweep, another track's scenario) takes them as they are: every model
+    of the field shares them, so nothing may change them in place (the route network's confined
+    models make new ones).
+    """
+    t = scenario.tracks
+    key = (float(t.clearance_m), t.risk_model, t.buffer_measure)
+    kept = vars(field).get("_planning_arrays")  # a cache beside the frozen dataclass's fields
+    if kept is not None and kept[0] == key:
+        return kept[1]
     grid = field.grid
-    s_min = scenario.tracks.clearance_m
+    s_min = t.clearance_m
     in_band = np.zeros(grid.shape[2], dtype=bool)
     in_band[field.band_layers()] = True
     admissible = ~(field.obstacle | field.no_fly) & in_band[None, None, :]
     admissible &= clearance_ok(building_cells(field), grid.cell, s_min)
-    if scenario.tracks.risk_model == "binary":  # 0/1 as uint8: an eighth of float64's memory, the same costs
+    if t.risk_model == "binary":  # 0/1 as uint8: an eighth of float64's memory, the same costs
         risk = (field.unsafe & admissible).view(np.uint8)
     else:
         risk = np.where(admissible, np.nan_to_num(field.risk, nan=0.0), 0.0)
     n_s = buffer_cells(grid.cell, s_min)
-    measure = scenario.tracks.buffer_measure
-    occupied = (field.obstacle | field.no_fly) if measure == "structures" else field.unsafe
+    occupied = (field.obstacle | field.no_fly) if t.buffer_measure == "structures" else field.unsafe
     inner = [max(n - 2, 0) for n in n_s]
     shell_cells = int(np.prod(n_s) - np.prod(inner))  # the most a count can be
     shell = np.zeros(grid.shape, dtype=np.uint16 if shell_cells < 2**16 else np.uint32)
@@ -234,9 +249,20 @@ def planning_model(scenario: Scenario, field: RiskField) -> PlanningModel:
         lo, hi, reach = int(np.min(layers)), int(np.max(layers)) + 1, (n_s[2] - 1) // 2
         z0, z1 = max(0, lo - reach), min(grid.shape[2], hi + reach)
         shell[:, :, lo:hi] = buffer_shell_count(occupied[:, :, z0:z1], n_s)[:, :, lo - z0:hi - z0]
-    if measure == "share":
+    if t.buffer_measure == "share":
         # Variant: the unsafe share of the shell. With the count, the shell holds 26 cells at 50 m
         # but 602 at 10 m, so μ·R(t) grows 23-fold with resolution and outweighs Eq. 10 entirely.
         shell = shell / float(shell_cells)
+    arrays = (admissible, risk, shell)
+    vars(field)["_planning_arrays"] = (key, arrays)
+    return arrays
+
+
+def planning_model(scenario: Scenario, field: RiskField) -> PlanningModel:
+    """Admissible cells, Eq. 11 risk, the buffer's shell counts and transport rates (the arrays
+    from :func:`field_arrays`, built once per field and :data:`ARRAY_KEYS`)."""
+    check_aircraft_limits(scenario)
+    admissible, risk, shell = field_arrays(scenario, field)
     c_h, c_v = transport_rates(scenario)
-    return PlanningModel(scenario, field, admissible, risk, shell, n_s, c_h, c_v)
+    return PlanningModel(scenario, field, admissible, risk, shell, buffer_cells(field.grid.cell, scenario.tracks.clearance_m),
+                         c_h, c_v)
