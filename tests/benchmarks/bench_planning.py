@@ -25,6 +25,11 @@ Run on demand (not collected by pytest; several minutes, most of it the 8010 maz
       the paper's own time for its optimal track (68.7 s at 10 m, 659.5 s at 5 m). Targets: plan
       at 10 m <= 3 s (>= 35x the paper), at 5 m <= 10 s and <= 1.2 GB; each estimate within 20 %.
 
+(vii) The 3-D search on the Moving AI voxel benchmark (tests/data/warframe: ``Simple`` and ``Complex``,
+      ``--voxel-rows`` rows of each, evenly spread; 0 skips it) beside tcod's compiled A* on the same
+      queries (bench_voxel.py's runs; that script has the full table). Target: every row optimal,
+      median per query <= tcod's.
+
 (ii) and (iv) each run in a fresh subprocess, so each peak memory (``ru_maxrss``, which includes
 the city and the risk field the planner needs, and the clearance peer's scipy transform) is that
 cell size's alone.
@@ -185,6 +190,35 @@ def whole_command(command: str, cell_m: float) -> dict:
             "estimate_gb": memory_estimate(cells, "plan" if command == "plan" else "risk") / 2**30}
 
 
+def voxel_rows(n: int) -> list[tuple[str, str, str, str]]:
+    """(vii): bench_voxel.py's runs on ``n`` rows of each Warframe map, as rows of this table."""
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    import bench_voxel as bv
+
+    from uamopt.planning.voxel import read_voxel_map, read_voxel_map_text, read_voxel_scenarios, voxel_problem
+
+    try:
+        import tcod.path  # noqa: F401
+    except ImportError:
+        return [("(vii) Warframe voxel maps", "tcod is not installed (pip install tcod==21.2.2): skipped", "", "")]
+    tiny = voxel_problem(read_voxel_map_text("voxel 3 3 3\n1 1 1\n"))  # compile for the voxel problems' array types
+    grid_search(tiny, (0, 0, 0), (2, 2, 2))
+    rows = []
+    for name in ("Simple", "Complex"):
+        voxels = read_voxel_map(bv.WARFRAME / f"{name}.3dmap")
+        queries = bv.evenly(read_voxel_scenarios(bv.WARFRAME / f"{name}.3dmap.3dscen"), n)
+        ours = bv.run_uamopt(voxel_problem(voxels), queries, "relaxed")
+        graph, keep = bv.tcod_graph(voxels.passable)
+        theirs = bv.run_tcod(graph, queries)
+        del graph, keep
+        med, t_med = (1e3 * float(np.median(r["seconds"])) for r in (ours, theirs))
+        result = (f"{ours['optimal']}/{len(queries)} rows optimal (tcod {theirs['optimal']}); median {med:.1f} ms "
+                  f"vs tcod {t_med:.1f} ms: {med / t_med:.2f}x")
+        ok = ours["optimal"] == len(queries) and med <= t_med
+        rows.append((f"(vii) Warframe {name}", result, "all optimal, <= tcod", verdict(ok)))
+    return rows
+
+
 def run_child(cell_m: float) -> dict:
     out = subprocess.run([sys.executable, __file__, "--child", str(cell_m)], check=True, capture_output=True,
                          text=True, cwd=ROOT)
@@ -200,6 +234,7 @@ def main() -> None:
     parser.add_argument("--movingai-rows", type=int, default=0, help="rows per map, evenly spread; 0 = all")
     parser.add_argument("--nx-cell", type=float, default=20.0, help="cell side (m) of the networkx comparison")
     parser.add_argument("--cells", type=float, nargs="*", default=[10.0, 5.0], help="cell sides (m) to plan at")
+    parser.add_argument("--voxel-rows", type=int, default=200, help="Warframe rows per map for (vii); 0 = skip")
     parser.add_argument("--child", type=float, help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.child is not None:
@@ -258,6 +293,8 @@ def main() -> None:
                   f"search only; costs {'agree' if agree else 'DIFFER'} ({p['fast_cost']:.6f})")
         table.append((f"(iii) initial search {p['cell_m']:g} m {tuple(p['shape'])}", result,
                       f">= {TARGET_RATIO:g}x", verdict(ratio >= TARGET_RATIO and agree)))
+    if args.voxel_rows:
+        table += voxel_rows(args.voxel_rows)
     width = max(len(row[0]) for row in table)
     print(f"{'benchmark':<{width}}  result  [target, verdict]")
     for name, result, target, ok in table:
