@@ -138,10 +138,10 @@ def test_wrong_type_first_argument(name, before, parameter, expected, bad):
 
 
 @pytest.mark.parametrize("bad", ["no", 0, None])
-def test_compute_risk_keep_terms_type(scenario, bad):
+def test_compute_risk_keep_risk_type(scenario, bad):
     """A truthy string would have kept the terms: "no" must be refused, not read as True."""
-    with pytest.raises(TypeError, match=rf"compute_risk\(\): keep_terms must be a bool, got {type(bad).__name__}"):
-        ua.compute_risk(scenario, keep_terms=bad)
+    with pytest.raises(TypeError, match=rf"compute_risk\(\): keep_risk must be a bool, got {type(bad).__name__}"):
+        ua.compute_risk(scenario, keep_risk=bad)
 
 
 def test_planning_model_field_type(scenario):

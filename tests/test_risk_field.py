@@ -42,12 +42,12 @@ def recompute_cell(s: Scenario, vr: float, h: float, cs: float, rho_p: float, l_
 @pytest.fixture(scope="module", params=["kept", "computed on first use"])
 def npz(request, paper_run, tmp_path_factory):
     """The paper case's risk.npz: from a field that kept its three terms as computed, and from one
-    that did not (``keep_terms=False``, a planning run's field), whose terms ``save_npz`` computes."""
+    that did not (``keep_risk=False``, a planning run's field), whose terms ``save_npz`` computes."""
     field = paper_run.field
     if request.param != "kept":
         import uamopt as ua
 
-        field = ua.compute_risk(paper_run.scenario, keep_terms=False)
+        field = ua.compute_risk(paper_run.scenario, keep_risk=False)
         assert field.terms is None  # nothing of the terms' size is held before they are asked for
     path = tmp_path_factory.mktemp("risk") / "risk.npz"
     field.save_npz(path)

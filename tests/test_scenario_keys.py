@@ -182,8 +182,9 @@ def test_every_scenario_key_is_read(tmp_path, network_file, monkeypatch):
 
 def test_the_memory_guard_counts_what_each_command_keeps(tmp_path, capsys):
     """On the paper case's 54,000 cells ``uamopt risk`` needs 120 MiB + 50 B a cell = 0.12 GB and
-    ``uamopt plan`` (numba's and cvxpy's libraries, the planning model, a search) 305 MiB + 28 B a
-    cell = 0.30 GB: under a 0.2 GB limit the first runs and the second is refused before any work."""
+    ``uamopt plan`` (numba's and cvxpy's libraries, the planning model, a search) 255 MiB + 23 B a
+    cell = 0.25 GB (printed 0.3): under a 0.2 GB limit the first runs and the second is refused
+    before any work."""
     limit = ["--set", "grid.memory_limit_gb=0.2", "--no-figures"]
     assert main(["risk", str(PAPER_CASE), *limit, "--out", str(tmp_path / "risk")]) == 0
     capsys.readouterr()

@@ -106,7 +106,7 @@ def load_risk(path: str | Path) -> RiskField:
         c = summary["constants"]
         constants = RiskConstants(c["mass_kg"], c["crash_area_m2"], c["drag_k_per_m"], c["terminal_speed_mps"],
                                   c["mean_relative_speed_mps"], c["vehicle_collision_probability"])
-        return RiskField(grid=grid, city=city, risk=a["risk"], terms={name: a[name] for name in ("risk_P", "risk_V", "risk_U")},
+        return RiskField(grid=grid, city=city, terms={name: a[name] for name in ("risk", "risk_P", "risk_V", "risk_U")},
                          unsafe=a["unsafe"], obstacle=a["obstacle"],
                          band=tuple(summary["band_m"]), constants=constants, threshold=float(rk["threshold_R0"]),  # type: ignore[arg-type]
                          seconds=float(summary.get("seconds", {}).get("risk", 0.0)),

@@ -59,24 +59,24 @@ def scenario_grid(scenario: Scenario, *, use: str = "risk") -> AirspaceGrid:
     return build_grid(extent, scenario.grid.cell, memory_limit_gb=scenario.grid.memory_limit_gb, use=use)
 
 
-def compute_risk(scenario: Scenario, *, keep_terms: bool = True) -> RiskField:
+def compute_risk(scenario: Scenario, *, keep_risk: bool = True) -> RiskField:
     """Grid, city layers and the risk field of Eqs. 1–9 / A.1–A.9 (Sec. 3, 4.1.1, App. A).
 
     The returned field carries its timings in ``meta["seconds"]`` (city, risk, total) and
-    ``summary()`` gives the risk command's ``summary.json``. With ``keep_terms=False`` the three
-    risk terms are computed again when first used instead of kept (a planning run's memory:
-    :func:`uamopt.risk.risk_field`).
+    ``summary()`` gives the risk command's ``summary.json``. With ``keep_risk=False`` the
+    continuous risk (Eq. 8 and its three terms) is computed again when first used instead of kept:
+    a planning run's memory (:func:`uamopt.risk.risk_field`).
     """
     from uamopt.city import load_city
     from uamopt.risk import risk_field
 
     expect(scenario, Scenario, "scenario", "compute_risk")
-    expect(keep_terms, bool, "keep_terms", "compute_risk")
+    expect(keep_risk, bool, "keep_risk", "compute_risk")
     t0 = time.perf_counter()
-    grid = scenario_grid(scenario, use="risk" if keep_terms else "plan")
+    grid = scenario_grid(scenario, use="risk" if keep_risk else "plan")
     city = load_city(scenario, grid)
     t1 = time.perf_counter()
-    field = risk_field(scenario, grid, city, keep_terms=keep_terms)
+    field = risk_field(scenario, grid, city, keep_risk=keep_risk)
     t2 = time.perf_counter()
     field.meta["seconds"] = {"city": t1 - t0, "risk": t2 - t1, "total": t2 - t0}
     return field
@@ -205,7 +205,7 @@ def scenario_flights(scenario: Scenario, flights_file=None, network_file=None, s
                            str(flights_file), "flight")
         return flights
     if network is None:
-        network = plan_network(planning_model(scenario, compute_risk(scenario, keep_terms=False)))
+        network = plan_network(planning_model(scenario, compute_risk(scenario, keep_risk=False)))
     return generate_flights(scenario, network, seed)
 
 

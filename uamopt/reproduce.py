@@ -25,7 +25,7 @@ def plan_at(scenario: Scenario, side: float, extent) -> tuple:
     started = time.perf_counter()
     extent_text = "[" + ",".join(f"{float(v)!r}" for v in extent) + "]"
     fine = scenario.with_overrides([f"grid.cell=[{side},{side},{side}]", f"grid.extent={extent_text}"])
-    model = planning_model(fine, compute_risk(fine, keep_terms=False))
+    model = planning_model(fine, compute_risk(fine, keep_risk=False))
     return fine, model, plan_track(model), time.perf_counter() - started
 
 

@@ -180,6 +180,7 @@ class TermModel:
     uav_scale: float  # λ ρ_U e_w e_h
     mean_speed_mps: float  # v_r' (A.6)
     fuselage_length_m: float  # e_l
+    weights: tuple[float, float, float]  # w1, w2, w3 of Eq. 8
 
     @classmethod
     def of(cls, scenario: Scenario, grid: AirspaceGrid, city: CityLayers, c: RiskConstants) -> TermModel:
@@ -195,6 +196,7 @@ class TermModel:
             log_beta_over_half_mg_k=math.log(r.beta_j) - math.log(0.5 * c.mass_kg * g / c.k_per_m),
             root_gk=math.sqrt(g * c.k_per_m), uav_scale=lam * r.uav_density_per_m3 * a.wingspan_m * a.height_m,
             mean_speed_mps=c.mean_relative_speed_mps, fuselage_length_m=a.fuselage_length_m,
+            weights=tuple(float(w) for w in r.weights),  # type: ignore[arg-type]
         )
 
     def layer(self, z: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -214,8 +216,14 @@ class TermModel:
         risk_u = self.uav_scale * (self.mean_speed_mps * t_fall + self.fuselage_length_m)  # A.4-A.5
         return risk_p, risk_v, risk_u, blocked
 
+    def combined(self, risk_p: np.ndarray, risk_v: np.ndarray, risk_u: np.ndarray) -> np.ndarray:
+        """R of Eq. 8 from one layer's terms."""
+        w1, w2, w3 = self.weights
+        return w1 * risk_p + w2 * risk_v + w3 * risk_u
 
-TERMS = ("risk_P", "risk_V", "risk_U")
+
+#: the continuous arrays of a field: Eq. 8 and its three terms
+TERMS = ("risk", "risk_P", "risk_V", "risk_U")
 
 
 @dataclass(frozen=True)
@@ -226,15 +234,14 @@ class RiskField:
     obstacle cells); ``unsafe`` is Eq. 9 (risk > R_0, obstacle or no-fly); ``obstacle`` marks
     cells inside or below a building.
 
-    The terms are kept as computed (``risk_field(..., keep_terms=True)``, the default, and a
-    loaded ``risk.npz``) or else computed on first use from ``term_model``, all three in one pass,
-    and kept from then on: the planner needs only ``risk`` and ``unsafe``, and at 5 m cells the
-    three float64 terms are 0.78 GB of a plan's memory.
+    These four continuous arrays are kept as computed (``risk_field(..., keep_risk=True)``, the
+    default, and a loaded ``risk.npz``) or else computed on first use from ``term_model``, all four
+    in one pass, and kept from then on: the planner's default binary field needs only ``unsafe``,
+    and at 5 m cells the four float64 arrays are 1.04 GB of a plan's memory.
     """
 
     grid: AirspaceGrid
     city: CityLayers
-    risk: np.ndarray
     unsafe: np.ndarray
     obstacle: np.ndarray
     band: tuple[float, float]
@@ -242,19 +249,32 @@ class RiskField:
     threshold: float
     seconds: float = 0.0
     meta: dict = field(default_factory=dict)
-    terms: dict[str, np.ndarray] | None = field(default=None, repr=False, compare=False)
+    terms: dict[str, np.ndarray] | None = field(default=None, repr=False, compare=False)  # TERMS, or None
     term_model: TermModel | None = field(default=None, repr=False, compare=False)
 
     def _terms(self) -> dict[str, np.ndarray]:
         if self.terms is None:
             if self.term_model is None:
-                raise ValueError("this risk field holds neither its terms nor the model to compute them")
+                raise ValueError("this risk field holds neither its risk arrays nor the model to compute them")
             computed = {name: np.empty(self.grid.shape) for name in TERMS}
             for k, z in enumerate(self.grid.z):
-                for name, values in zip(TERMS, self.term_model.layer(z)[:3], strict=True):
-                    computed[name][:, :, k] = values
+                risk_p, risk_v, risk_u, _ = self.term_model.layer(z)
+                values = (self.term_model.combined(risk_p, risk_v, risk_u), risk_p, risk_v, risk_u)
+                for name, layer in zip(TERMS, values, strict=True):
+                    computed[name][:, :, k] = layer
             object.__setattr__(self, "terms", computed)  # a cache of what the field already defines
         return self.terms  # type: ignore[return-value]
+
+    def release(self) -> None:
+        """Forget the continuous arrays where they can be computed again (a field from
+        :func:`risk_field`; a loaded one keeps them): the memory of a plan after a summary."""
+        if self.term_model is not None:
+            object.__setattr__(self, "terms", None)
+
+    @property
+    def risk(self) -> np.ndarray:
+        """R of Eq. 8, per flight hour (NaN in obstacle cells)."""
+        return self._terms()["risk"]
 
     @property
     def risk_P(self) -> np.ndarray:
@@ -378,7 +398,7 @@ class RiskField:
         }
 
 
-def risk_field(scenario: Scenario, grid: AirspaceGrid, city: CityLayers, *, keep_terms: bool = True) -> RiskField:
+def risk_field(scenario: Scenario, grid: AirspaceGrid, city: CityLayers, *, keep_risk: bool = True) -> RiskField:
     """Compute Eqs. 1–9 for every cell of ``grid`` over ``city``.
 
     Parameters
@@ -389,9 +409,10 @@ def risk_field(scenario: Scenario, grid: AirspaceGrid, city: CityLayers, *, keep
         The cells.
     city : CityLayers
         Column layers on ``grid``'s footprint.
-    keep_terms : bool
-        Keep R^P, R^V and R^U as computed (three float64 arrays the size of the grid); with
-        False they are computed again on first use (the planner never uses them).
+    keep_risk : bool
+        Keep R (Eq. 8), R^P, R^V and R^U as computed (four float64 arrays the size of the grid);
+        with False only Eq. 9's ``unsafe`` and ``obstacle`` are kept, and the four are computed
+        again on first use (the planner's default binary field never uses them).
 
     Returns
     -------
@@ -412,11 +433,9 @@ def risk_field(scenario: Scenario, grid: AirspaceGrid, city: CityLayers, *, keep
     """
     started = time.perf_counter()
     r, c = scenario.risk, RiskConstants.from_scenario(scenario)
-    w1, w2, w3 = r.weights
     shape = grid.shape
     model = TermModel.of(scenario, grid, city, c)
-    risk = np.empty(shape)
-    terms = {name: np.empty(shape) for name in TERMS} if keep_terms else None
+    terms = {name: np.empty(shape) for name in TERMS} if keep_risk else None
     unsafe = np.empty(shape, dtype=bool)
     obstacle = np.empty(shape, dtype=bool)
 
@@ -424,15 +443,15 @@ def risk_field(scenario: Scenario, grid: AirspaceGrid, city: CityLayers, *, keep
     # temporaries stay the size of one layer (memory ~ outputs only, even at 5 m cells).
     for k, z in enumerate(grid.z):
         risk_p, risk_v, risk_u, blocked = model.layer(z)
+        layer = model.combined(risk_p, risk_v, risk_u)  # Eq. 8
         if terms is not None:
-            terms["risk_P"][:, :, k], terms["risk_V"][:, :, k], terms["risk_U"][:, :, k] = risk_p, risk_v, risk_u
-        layer = w1 * risk_p + w2 * risk_v + w3 * risk_u  # Eq. 8
-        risk[:, :, k] = layer
+            for name, values in zip(TERMS, (layer, risk_p, risk_v, risk_u), strict=True):
+                terms[name][:, :, k] = values
         with np.errstate(invalid="ignore"):
             unsafe[:, :, k] = (layer > r.threshold) | blocked | city.no_fly  # Eq. 9
         obstacle[:, :, k] = blocked
     return RiskField(
-        grid=grid, city=city, risk=risk, unsafe=unsafe, obstacle=obstacle, band=altitude_band(scenario), constants=c,
+        grid=grid, city=city, unsafe=unsafe, obstacle=obstacle, band=altitude_band(scenario), constants=c,
         threshold=r.threshold, seconds=time.perf_counter() - started,
         meta={"scenario": scenario.name, "weights": tuple(r.weights), "inputs": field_inputs(scenario)},
         terms=terms, term_model=model,

@@ -68,7 +68,7 @@ def plan_folder(scenario: Scenario, out: str | Path, origin=None, destination=No
 
     check_out_dir(out)
     with progress(3, "plan") as bar, staged_output(out) as stage:
-        model = planning_model(scenario, compute_risk(scenario, keep_terms=False))
+        model = planning_model(scenario, compute_risk(scenario, keep_risk=False))
         bar.update(1)
         plan = plan_track(model, origin, destination)
         bar.update(1)
@@ -88,7 +88,7 @@ def network_folder(scenario: Scenario, out: str | Path, figures: bool = True):
 
     check_out_dir(out)
     with progress(2 + 2 * len(scenario.network.route_list()), "network") as bar, staged_output(out) as stage:
-        model = planning_model(scenario, compute_risk(scenario, keep_terms=False))
+        model = planning_model(scenario, compute_risk(scenario, keep_risk=False))
         bar.update(2)
         network = plan_network(model, progress=bar)
         write_network(network, model, scenario, stage, figures)

@@ -40,7 +40,7 @@ def scenario_problem(scenario, seed: int = 0):
     flight plan (plan seed ``schedule.plan_seed + seed``)."""
     from uamopt.pipeline import compute_risk, plan_network, planning_model
 
-    return scheduling_problem(scenario, plan_network(planning_model(scenario, compute_risk(scenario, keep_terms=False))), seed)
+    return scheduling_problem(scenario, plan_network(planning_model(scenario, compute_risk(scenario, keep_risk=False))), seed)
 
 
 def _instances(problem_or_scenarios) -> dict:

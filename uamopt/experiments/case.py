@@ -50,17 +50,18 @@ def _unless_out_of_space(exc: Exception) -> None:
                            "free some space or raise the file size limit (ulimit -f), then run the sweep again") from exc
 
 
-#: the last case's risk field in this process, with its key: a worker runs case after case, and the
-#: cases of a sweep over planning or scheduling keys (weights, μ, solvers) share one field, and
-#: with it the planning model's costly arrays (uamopt.planning.problem.field_arrays)
+#: the last case's risk field in this process, with its key and its risk metrics: a worker runs case
+#: after case, and the cases of a sweep over planning or scheduling keys (weights, μ, solvers)
+#: share one field, and with it the planning model's costly arrays (uamopt.planning.problem.field_arrays)
 _LAST_FIELD: list = []
 
 
-def case_field(scenario):
-    """The case's risk field, without its three terms (a row needs the summary only): the last
-    case's when this one's field inputs are the same. The key is the scenario's name, the digests
-    of the field's sections (uamopt.risk.field_inputs) and its ``[network]`` section, whose
-    vertiports the synthetic city keeps clear of buildings."""
+def case_field(scenario) -> tuple:
+    """(field, its risk metrics) of the case: the last case's when this one's field inputs are the
+    same. The key is the scenario's name, the digests of the field's sections
+    (uamopt.risk.field_inputs) and its ``[network]`` section (the synthetic city keeps its vertiports
+    clear of buildings; the cruise layer of the metrics). The field keeps only Eq. 9's cells: its
+    continuous risk is computed for the metrics and then released."""
     import hashlib
     import json
 
@@ -70,11 +71,13 @@ def case_field(scenario):
     network = hashlib.sha256(json.dumps(scenario.network.model_dump(mode="json"), sort_keys=True).encode()).hexdigest()
     key = (scenario.name, tuple(sorted(field_inputs(scenario).items())), network)
     if _LAST_FIELD and _LAST_FIELD[0][0] == key:
-        return _LAST_FIELD[0][1]
+        return _LAST_FIELD[0][1:]
     _LAST_FIELD.clear()  # the old field is freed before the next one is computed
-    field = compute_risk(scenario, keep_terms=False)
-    _LAST_FIELD.append((key, field))
-    return field
+    field = compute_risk(scenario, keep_risk=False)
+    metrics = risk_metrics(scenario, field)
+    field.release()
+    _LAST_FIELD.append((key, field, metrics))
+    return field, metrics
 
 
 def risk_metrics(scenario, field) -> dict:
@@ -186,8 +189,8 @@ def run_case(scenario, stage: str, solvers=(), seeds=(0,)) -> list[dict]:
     keys = [{"solver": p.name, "seed": s} for p in solvers for s in seeds] if schedule else [{}]
     try:
         t0 = time.perf_counter()
-        field = case_field(scenario)
-        common = {**risk_metrics(scenario, field), "seconds": time.perf_counter() - t0}
+        field, metrics = case_field(scenario)
+        common = {**metrics, "seconds": time.perf_counter() - t0}
         if stage == "risk":
             return [{**common, "status": "ok"}]
         model = planning_model(scenario, field)

@@ -136,14 +136,14 @@ def altitude_band(scenario: Scenario) -> tuple[float, float]:
 
 
 #: Peak memory of a run, bytes = fixed + per cell × cells, for what the run keeps of the field:
-#: ``"risk"``, the risk field with its three terms (``uamopt risk``, ``ua.compute_risk``); ``"plan"``,
-#: the field without them, the planning model and one search (``uamopt plan``, ``network``,
+#: ``"risk"``, the risk field with its continuous arrays (``uamopt risk``, ``ua.compute_risk``);
+#: ``"plan"``, Eq. 9's cells only, the planning model and one search (``uamopt plan``, ``network``,
 #: ``reproduce``'s track stages). The fixed part is the interpreter, the libraries (numba's and
 #: cvxpy's for a plan) and the city. Fitted on the peak RSS of the whole command, paper case,
 #: ``--no-figures``, at 10 m and 5 m cells (4.05 M and 32.4 M cells; tests/benchmarks/bench_planning.py
-#: row (vi) prints each estimate beside its measured peak): ``plan`` 0.40 and 1.10 GB, ``risk`` 0.30
-#: and 1.55 GB; the per-cell parts are rounded up, so the estimates lie 1-5 % above the peaks.
-MEMORY_MODEL = {"risk": (120 * 2**20, 50), "plan": (305 * 2**20, 28)}
+#: row (vi) prints each estimate beside its measured peak): ``plan`` 0.33 and 0.90 GB, ``risk`` 0.30
+#: and 1.55 GB; the per-cell parts are rounded up, so the estimates lie a few per cent above the peaks.
+MEMORY_MODEL = {"risk": (120 * 2**20, 50), "plan": (255 * 2**20, 23)}
 
 
 def memory_limit_bytes(limit_gb: float | None = None) -> int:
@@ -190,7 +190,7 @@ def memory_estimate(cells: float, use: str = "risk") -> float:
     """The peak memory, bytes, of a run on a grid of ``cells`` cells (:data:`MEMORY_MODEL`).
 
     >>> round(memory_estimate(32_400_000, "plan") / 2**30, 2)  # the paper case at 5 m cells
-    1.14
+    0.94
     """
     fixed, per_cell = MEMORY_MODEL[use]
     return fixed + per_cell * cells
