@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import errno
 import json
+import math
 import os
 import re
 import shutil
@@ -36,8 +37,6 @@ from contextlib import contextmanager, suppress
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
-
-import numpy as np
 
 from uamopt.errors import NoSpaceError, UamoptError
 from uamopt.interrupts import deferred_signals
@@ -304,15 +303,19 @@ def staged_output(out_dir: str | Path, option: str = "--out") -> Iterator[Path]:
 
 
 def _jsonable(value: Any) -> Any:
+    # numpy as already imported, if it is: this module imports none, so that the line after an
+    # interrupt (uamopt.cli._interrupted asks `published`) never imports it again; a signal inside
+    # numpy's own import leaves it unloadable ("cannot load module more than once per process")
+    np = sys.modules.get("numpy")
     if isinstance(value, dict):
         return {str(k): _jsonable(v) for k, v in value.items()}
     if isinstance(value, (list, tuple)):
         return [_jsonable(v) for v in value]
-    if isinstance(value, np.ndarray):
+    if np is not None and isinstance(value, np.ndarray):
         return _jsonable(value.tolist())
-    if isinstance(value, np.generic):
+    if np is not None and isinstance(value, np.generic):
         return value.item()
-    if isinstance(value, float) and not np.isfinite(value):
+    if isinstance(value, float) and not math.isfinite(value):
         return None
     if isinstance(value, Path):
         return str(value)
