@@ -311,6 +311,32 @@ def test_ctrl_c_inside_numpys_import_is_one_line(tmp_path):
     assert not out.exists()
 
 
+SHIPPED_CUT = """import sys
+class Cut:  # Ctrl-C while the shipped-scenario lookup is imported, just after the command line is read
+    def find_spec(self, name, path=None, target=None):
+        if name == "uamopt.shipped":
+            raise KeyboardInterrupt
+        return None
+sys.meta_path.insert(0, Cut())
+sys.argv = ["uamopt", "risk", "paper_case", "--out", sys.argv[1]]
+from uamopt.cli import main
+sys.exit(main())
+"""
+
+
+def test_ctrl_c_while_the_shipped_scenario_is_looked_up_is_one_line(tmp_path):
+    """The census (SIGINT into `uamopt risk`, SIGTERM into `uamopt schedule`, 0.035-0.05 s in)
+    found the signal in the step between reading the command line and running it (the shipped
+    scenario's lookup, importing importlib.resources), which no handler covered: a
+    KeyboardInterrupt traceback and exit -2, or a Terminated traceback and exit 1."""
+    out = tmp_path / "risk"
+    done = subprocess.run([sys.executable, "-c", SHIPPED_CUT, str(out)], cwd=ROOT, capture_output=True, text=True,
+                          check=False, timeout=120)
+    assert done.returncode == 130, done.stderr[-3000:]
+    assert done.stderr == f"interrupted: nothing was written to {out}\n"
+    assert not out.exists()
+
+
 CLUSTER_CUT = """import os, signal, sys, threading
 import distributed
 start = distributed.LocalCluster.__init__

@@ -374,8 +374,8 @@ def _main(argv: list[str] | None) -> int:
         args = build_parser().parse_args(argv)
     except KeyboardInterrupt as exc:
         return _interrupted(None, exc)
-    _shipped_files(args)
     try:
+        _shipped_files(args)  # inside: a signal while it imports (importlib.resources, typing) is one line too
         return args.func(args)
     except UamoptError as exc:
         sys.stderr.write(f"error: {exc.line()}\n")
