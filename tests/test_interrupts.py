@@ -281,6 +281,16 @@ def test_a_finished_command_runs_the_exit_hooks_and_skips_the_interpreters_teard
     assert sorted(p.name for p in marks.iterdir()) == ["atexit", "teardown"]
 
 
+def assert_one_interrupt_line(script: str, out) -> None:
+    """``script`` (a uamopt command whose import is cut by Ctrl-C) ends with exit 130, the one line
+    and nothing written to ``out``."""
+    done = subprocess.run([sys.executable, "-c", script, str(out)], cwd=ROOT, capture_output=True, text=True,
+                          check=False, timeout=120)
+    assert done.returncode == 130, done.stderr[-3000:]
+    assert done.stderr == f"interrupted: nothing was written to {out}\n"
+    assert not out.exists()
+
+
 NUMPY_CUT = """import sys
 class Cut:  # numpy's import cut by Ctrl-C, as a signal inside its C extension's initialisation leaves it
     calls = 0
@@ -304,11 +314,7 @@ def test_ctrl_c_inside_numpys_import_is_one_line(tmp_path):
     uamopt.outputs), which a half-initialised extension refuses: a 40-line ImportError traceback,
     exit 1. The line after an interrupt imports nothing heavy now."""
     out = tmp_path / "plan"
-    done = subprocess.run([sys.executable, "-c", NUMPY_CUT, str(out)], cwd=ROOT, capture_output=True, text=True,
-                          check=False, timeout=120)
-    assert done.returncode == 130, done.stderr[-3000:]
-    assert done.stderr == f"interrupted: nothing was written to {out}\n"
-    assert not out.exists()
+    assert_one_interrupt_line(NUMPY_CUT, out)
 
 
 SHIPPED_CUT = """import sys
@@ -330,11 +336,7 @@ def test_ctrl_c_while_the_shipped_scenario_is_looked_up_is_one_line(tmp_path):
     scenario's lookup, importing importlib.resources), which no handler covered: a
     KeyboardInterrupt traceback and exit -2, or a Terminated traceback and exit 1."""
     out = tmp_path / "risk"
-    done = subprocess.run([sys.executable, "-c", SHIPPED_CUT, str(out)], cwd=ROOT, capture_output=True, text=True,
-                          check=False, timeout=120)
-    assert done.returncode == 130, done.stderr[-3000:]
-    assert done.stderr == f"interrupted: nothing was written to {out}\n"
-    assert not out.exists()
+    assert_one_interrupt_line(SHIPPED_CUT, out)
 
 
 CLUSTER_CUT = """import os, signal, sys, threading
