@@ -68,6 +68,21 @@ def test_grid_model_is_exact_on_its_grid_and_relaxed_bounds_the_continuous_optim
         assert score(data, relaxed.operated, relaxed.delay_s) >= continuous - OBJ_TOL
 
 
+@settings(max_examples=25, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
+@given(tiny_problems(max_flights=5))
+def test_coarse_to_fine_ends_at_the_fine_grids_optimum(case):
+    """refine_step_s: the 10 s grid, then the 5 s grid from its best; the result is the 5 s grid's
+    optimum by enumeration (tests/oracles.py), whatever the 10 s grid gave."""
+    _, problem = case
+    data = model_data(problem)
+    expected = grid_optimum(data, 5.0)
+    result = solve(problem, ti(step_s=10.0, refine_step_s=5.0))  # 30 s: 18 s for the 5 s grid (≥ REFINE_MIN_S)
+    assert "then the 5 s grid" in result.extras["refined"]
+    assert broken(data, result.operated, result.delay_s) == []
+    assert score(data, result.operated, result.delay_s) == pytest.approx(expected, abs=OBJ_TOL), result.extras.get("refined")
+    np.testing.assert_allclose(result.delay_s / 5.0, np.rint(result.delay_s / 5.0), atol=1e-9)
+
+
 @pytest.fixture(scope="module")
 def paper_problem(paper_straight_plan):
     scenario, _, _, plan = paper_straight_plan
@@ -90,9 +105,9 @@ def test_exact_profile_on_the_paper_case(paper_problem, tmp_path):
     assert grid.gap == pytest.approx((grid.objective - grid.bound) / abs(grid.objective))
     write_schedule(tmp_path, problem, grid)
     assert verify_dir(tmp_path) == []
-    summary = grid.summary()
-    assert summary["model"].startswith("delay grid 10 s") and summary["status"] == "optimal_on_grid"
-    assert summary["model_kind"] == "delay grid 10 s"
+    summary = grid.summary()  # solvers/exact.toml refines the 10 s grid to the 5 s grid (refine_step_s)
+    assert summary["model"].startswith("delay grid 5 s") and summary["status"] == "optimal_on_grid"
+    assert summary["model_kind"] == "delay grid 5 s" and "then the 5 s grid" in grid.extras["refined"]
     relaxed = solve(problem, ti(model="relaxed", step_s=10.0))
     assert relaxed.bound <= continuous.objective + OBJ_TOL
     assert relaxed.summary()["model"].startswith("delay cells 10 s (relaxation")
@@ -179,14 +194,14 @@ def test_highs_and_cpsat_in_one_process_either_order(root):
 
 
 def test_benchmark_names_the_model_and_reports_only_continuous_bounds(paper_problem):
-    """`exact` proves the 10 s delay grid, a restriction: its row says so (status optimal_on_grid,
-    model "delay grid 10 s"), and its bound, like every bound in the table, lies below the
+    """`exact` proves the 10 s delay grid, then the 5 s grid from it (refine_step_s), a restriction:
+    its row says so (status optimal_on_grid, model "delay grid 5 s"), and its bound, like every bound in the table, lies below the
     continuous optimum that HiGHS proves in the same table."""
     import uamopt as ua
 
     table = ua.benchmark(paper_problem, ["exact", "highs"], seeds=[0], time_limit_s=60, progress=False)
     exact, highs = (table[table["profile"] == name].iloc[0] for name in ("exact", "highs"))
-    assert (exact["status"], exact["model"]) == ("optimal_on_grid", "delay grid 10 s")
+    assert (exact["status"], exact["model"]) == ("optimal_on_grid", "delay grid 5 s")
     assert (highs["status"], highs["model"]) == ("optimal", "continuous")
     assert exact["bound"] <= highs["objective"] + OBJ_TOL and highs["bound"] <= highs["objective"] + OBJ_TOL
     assert exact["objective"] >= highs["objective"] - OBJ_TOL and table["verified"].all()

@@ -124,6 +124,29 @@ def check_points(raw, what: str, where: str, fix: str, minimum: int = 2, error: 
     return np.array(raw, dtype=float)
 
 
+def read_json(path, what: str, source: str, fix: str):
+    """The JSON document of the file ``path`` (UTF-8, a BOM allowed), else one
+    :class:`~uamopt.errors.InputFileError` naming ``what`` ("the flights file") at ``source``:
+    malformed JSON, not UTF-8, an integer beyond Python's limit, nesting too deep, unreadable.
+    ``fix`` says what a good file is (docs/interfaces.md)."""
+    import json
+    from pathlib import Path
+
+    try:
+        return json.loads(Path(path).read_text(encoding="utf-8-sig"))
+    except json.JSONDecodeError as exc:
+        raise InputFileError(f"malformed JSON: {exc.msg} at line {exc.lineno} column {exc.colno}", source,
+                             "fix the syntax") from None
+    except UnicodeDecodeError:
+        raise InputFileError(f"{what} is not UTF-8 text", source, "save it as UTF-8 JSON") from None
+    except ValueError as exc:  # an integer of more than 4300 digits (Python's int-string limit)
+        raise InputFileError(f"malformed JSON: {parse_error(exc)}", source, f"write every number in its range ({fix})") from None
+    except RecursionError:
+        raise InputFileError(f"{what} is nested too deeply to read", source, f"give {fix}") from None
+    except OSError as exc:
+        raise InputFileError(f"cannot read {what}: {exc.strerror or exc}", source, "check that the file is readable") from None
+
+
 def parse_error(exc: ValueError) -> str:
     """What a JSON or TOML parser's ``ValueError`` says, on one line; Python's int-string limit
     (an integer of more than 4300 digits) in words a user can act on."""

@@ -218,6 +218,10 @@ def build_parser() -> argparse.ArgumentParser:
     bench.add_argument("--seeds", nargs="+", type=_seed, metavar="SEED",
                        help="solver seeds: a count (--seeds 3 = 0 1 2) or a list (--seeds 0 1 2); default each profile's")
     bench.add_argument("--time-limit", type=float, metavar="SECONDS", help="time limit of every solver (default: each profile's)")
+    bench.add_argument("--against", metavar="FILE", help="results file of best known values (benchmarks/results.json): "
+                       "each run's distance to them in bench.csv and bench.md (docs/benchmarks.md)")
+    bench.add_argument("--update", action="store_true", help="with --against: record this run's better verified "
+                       "objectives and bounds in FILE (rewritten atomically; created if missing)")
     bench.set_defaults(func=cmd_bench)
     flight_sources(bench)
     verify = sub.add_parser("verify", help="check a schedule folder independently: exit 0 iff feasible and conflict-free",

@@ -8,6 +8,13 @@ profile (``performance_profile.png``): for each profile the fraction of instance
 median objective lies within a factor τ of the best profile's, with the ratio taken on the
 objective's distance to the best, r = 1 + (obj − best) / |best| (the objectives of Eq. 20 are
 negative, so a plain quotient would not order them); a run without a solution has r = ∞.
+
+With ``--against FILE`` (uamopt/experiments/results.py) a section *Against FILE* follows the
+instances: first, loudly, the contradictions (a bound of the file above a verified objective of
+this run, or this run's bound above the file's objective: one of the two is wrong) and the
+instances whose size differs from the file's; then per run the best known objective and bound,
+the distances ``to_best_objective`` and ``to_best_bound`` (negative: this run is better), the runs
+that beat the file in words, the instances the file does not have, and the file's rows no run matched.
 """
 
 from __future__ import annotations
@@ -94,9 +101,58 @@ def summary(table):
     return pd.DataFrame(rows)
 
 
-def bench_markdown(table) -> str:
+#: bench.csv columns the Runs table of bench.md leaves out (said elsewhere, or in the Against section)
+NOT_IN_RUNS = ("error", "objective_kind", "plan_seed", "scenario", "set", "best_known_objective", "best_known_bound",
+               "to_best_objective", "to_best_bound")
+
+
+def against_section(comparison) -> list[str]:
+    """The lines of bench.md's *Against FILE* section (module docstring)."""
+    from uamopt.experiments.results import REL_TOL, key_text
+
+    source = comparison.source
+    lines = ["", f"## Against {source}", ""]
+    for line in comparison.contradictions:
+        lines.append(f"- **CONTRADICTION**: {line}. Check the file's value (its `command` reruns it) and this run "
+                     "(`uamopt verify` on its schedule); do not record either until one is found wrong.")
+    for line in comparison.mismatches:
+        lines.append(f"- **NOT COMPARED**: {line}.")
+    if comparison.contradictions or comparison.mismatches:
+        lines.append("")
+    lines += [f"{comparison.matched} of {len(comparison.table)} runs matched a row of {source} (by `instance` and "
+              "`plan_seed`). `to_best_objective` = (objective − best_known_objective) / |best_known_objective|, "
+              "`to_best_bound` = (best_known_bound − bound) / |best_known_bound| with `bound` a lower bound of the "
+              "continuous problem; both negative when this run is better, shown here in %; values within "
+              f"{REL_TOL:g} × max(1, |value|) count as equal.", ""]
+    table = comparison.table
+    matched = table[table["best_known_objective"].notna() | table["best_known_bound"].notna()].copy()
+    if len(matched):
+        matched["to best objective %"] = 100.0 * matched["to_best_objective"]
+        matched["to best bound %"] = 100.0 * matched["to_best_bound"]
+        lines += _markdown(matched, ["instance", "plan_seed", "profile", "seed", "status", "verified", "objective",
+                                     "best_known_objective", "to best objective %", "bound", "best_known_bound",
+                                     "to best bound %"])
+        lines.append("")
+    if comparison.improvements:
+        lines += ["Runs that beat the best known values (record them with `--against "
+                  f"{source} --update`):", ""] + [f"- {line}." for line in comparison.improvements] + [""]
+    elif len(matched):
+        lines += ["No run beats the best known objective or bound.", ""]
+    if comparison.not_in_file:
+        lines.append(f"Not in {source} (add with `--update`): {', '.join(comparison.not_in_file)}.")
+        lines.append("")
+    if comparison.not_run:
+        lines += [f"Not run (rows of {source} no run matched):", ""]
+        lines += [f"- {key_text(*e.key)}: best objective {_num(e.best_objective.value) if e.best_objective else '-'}, "
+                  f"best bound {_num(e.best_bound.value) if e.best_bound else '-'}" for e in comparison.not_run]
+        lines.append("")
+    return lines[:-1]
+
+
+def bench_markdown(table, comparison=None) -> str:
     best, found_by = best_known(table)
-    instances = table.drop_duplicates("instance")[["instance", "flights", "aircraft", "conflicting_pairs"]].copy()
+    size = ["instance", "flights", "aircraft", "conflicting_pairs"] + (["plan_seed"] if "plan_seed" in table else [])
+    instances = table.drop_duplicates("instance")[size].copy()
     instances["best known objective"] = [best.get(i, math.nan) for i in instances["instance"]]
     instances["found by"] = [found_by.get(i, "-") for i in instances["instance"]]
     limits = sorted({_num(v) for v in table["time_limit_s"]})
@@ -106,6 +162,8 @@ def bench_markdown(table) -> str:
              f"seeds {sorted(set(table['seed']))}; time limit {', '.join(limits)} s; objective "
              f"{', '.join(sorted(set(table['objective_kind'])))}; {os.cpu_count()} CPUs, load average {load} at the end.",
              "", "## Instances", "", *_markdown(instances, list(instances.columns))]
+    if comparison is not None:
+        lines += against_section(comparison)
     lines += ["", "## By solver profile (median and range over seeds)", "",
               "`to best known %` = 100 (median objective − best known) / |best known|; `gap` = |objective − bound| / |objective| "
               "with `bound` always a bound of the continuous problem (Sec. 4.3; empty where the solver has none); "
@@ -119,19 +177,20 @@ def bench_markdown(table) -> str:
                                         "solve s median", "build s median"])
     if table["instance"].nunique() > 1:
         lines += ["", "## Performance profile", "", "![performance profile](performance_profile.png)"]
-    lines += ["", "## Runs", "", *_markdown(table, [c for c in table.columns if c not in ("error", "objective_kind")])]
+    lines += ["", "## Runs", "", *_markdown(table, [c for c in table.columns if c not in NOT_IN_RUNS])]
     errors = table[table["error"].notna()]
     if len(errors):
         lines += ["", "## Errors", ""] + [f"- {r.instance} {r.profile} seed {r.seed}: {r.error}" for r in errors.itertuples()]
     return "\n".join(lines) + "\n"
 
 
-def write_bench(out: str | Path, table) -> str:
-    """Write bench.csv, bench.md (and performance_profile.png) into ``out``, all or nothing."""
+def write_bench(out: str | Path, table, comparison=None) -> str:
+    """Write bench.csv, bench.md (and performance_profile.png) into ``out``, all or nothing;
+    ``comparison`` (uamopt.experiments.results.compare): the Against section of bench.md."""
     from uamopt.outputs import staged_output
     from uamopt.plotting.output import save
 
-    text = bench_markdown(table)
+    text = bench_markdown(table, comparison)
     with staged_output(out) as stage:
         table.to_csv(stage / "bench.csv", index=False, na_rep="")
         (stage / "bench.md").write_text(text, encoding="utf-8")

@@ -11,7 +11,10 @@ CP-SAT's own clocks, which the time limit bounds) and ``build_seconds`` = wall �
 building, data transfer). Before the timed runs each solver runs once, untimed, on a few flights
 (:func:`warm_up`), so no row carries a process's one-time costs (imports, helper processes).
 ``verified`` is the independent verifier's verdict on the written schedule
-(uamopt/schedule/verify.py), for every row.
+(uamopt/schedule/verify.py), for every row. Last, where the instance came from: ``plan_seed`` (the
+seed of its generated flight plan; empty for an airland file or a ``--flights`` plan),
+``scenario`` (the file) and ``set`` (the overrides, a JSON list), so that a row can be run again
+and recorded in a results file (``--against FILE --update``, uamopt/experiments/results.py).
 """
 
 from __future__ import annotations
@@ -27,7 +30,8 @@ from uamopt.progress import Progress
 
 COLUMNS = ["instance", "flights", "aircraft", "conflicting_pairs", "solver", "profile", "seed", "threads", "time_limit_s",
            "objective_kind", "status", "model", "objective", "bound", "gap", "operated", "cancelled", "total_delay_s",
-           "avg_delay_s", "wall_seconds", "solve_seconds", "build_seconds", "verified", "error"]
+           "avg_delay_s", "wall_seconds", "solve_seconds", "build_seconds", "verified", "error", "plan_seed", "scenario",
+           "set"]
 
 
 def instance_name(scenario, overrides=()) -> str:
@@ -43,8 +47,9 @@ def scenario_problem(scenario, seed: int = 0):
     return scheduling_problem(scenario, plan_network(planning_model(scenario, compute_risk(scenario, keep_risk=False))), seed)
 
 
-def _instances(problem_or_scenarios) -> dict:
-    """name -> SchedulingProblem from a problem, a scenario (object or file), or a list / dict of them."""
+def _instances(problem_or_scenarios, sources: dict | None = None) -> dict:
+    """name -> SchedulingProblem from a problem, a scenario (object or file), or a list / dict of them;
+    ``sources`` (when given) gets name -> the instance's plan seed, scenario file and overrides."""
     from uamopt.scenario import Scenario, load_scenario
     from uamopt.schedule import SchedulingProblem
 
@@ -56,9 +61,12 @@ def _instances(problem_or_scenarios) -> dict:
         named = [(None, item) for item in items]
     out: dict = {}
     for i, (name, item) in enumerate(named):
+        source = {}
         if isinstance(item, (str, Path)):
+            source["scenario"] = str(item)
             item = load_scenario(item)
         if isinstance(item, Scenario):
+            source |= {"plan_seed": item.schedule.plan_seed, "set": []}
             name, item = name or instance_name(item), scenario_problem(item)
         if not isinstance(item, SchedulingProblem):
             raise TypeError("benchmark(): problem_or_scenarios must be a SchedulingProblem, Scenario or path "
@@ -67,6 +75,8 @@ def _instances(problem_or_scenarios) -> dict:
         if name in out:
             name = f"{name}#{i + 1}"
         out[name] = item
+        if sources is not None:
+            sources[name] = source
     return out
 
 
@@ -128,7 +138,8 @@ def solve_row(name: str, problem, profile, seed: int) -> dict:
     return row
 
 
-def benchmark(problem_or_scenarios, solvers, seeds=None, time_limit_s: float | None = None, *, progress: bool = True):
+def benchmark(problem_or_scenarios, solvers, seeds=None, time_limit_s: float | None = None, *, progress: bool = True,
+              sources: dict | None = None):
     """Run every solver profile with every seed on every instance; one row per run (``COLUMNS``).
 
     Parameters
@@ -143,6 +154,9 @@ def benchmark(problem_or_scenarios, solvers, seeds=None, time_limit_s: float | N
         Applied to every profile instead of its own ``time_limit_s``.
     progress : bool
         A bar on a terminal, else a line per finished solve on stderr.
+    sources : dict, optional
+        Instance name -> ``{"plan_seed": int or None, "scenario": path, "set": [overrides]}``: the
+        ``plan_seed``, ``scenario`` and ``set`` columns (a scenario given as such fills its own).
 
     Returns
     -------
@@ -155,16 +169,23 @@ def benchmark(problem_or_scenarios, solvers, seeds=None, time_limit_s: float | N
         table = benchmark("models/paper_case.toml", ["greedy", "soa", "highs"], seeds=[0, 1, 2], time_limit_s=30)
         table.groupby("profile")["objective"].median()
     """
+    import json
+
     import pandas as pd
 
     profiles = _profiles(solvers, time_limit_s)
-    instances = _instances(problem_or_scenarios)
+    found: dict = {}
+    instances = _instances(problem_or_scenarios, found)
+    found |= sources or {}
     runs = [(name, p, s) for name in instances for p in profiles for s in (seeds if seeds is not None else [p.seed])]
     warm_up(instances.values(), profiles)
     rows = []
     bar = Progress(len(runs), "bench", "solves", every=True, stream=None) if progress else None
     for name, profile, seed in runs:
         row = solve_row(name, instances[name], profile, int(seed))
+        source = found.get(name, {})
+        row.update(plan_seed=source.get("plan_seed"), scenario=source.get("scenario"),
+                   set=json.dumps(list(source["set"])) if "set" in source else None)
         rows.append(row)
         if bar is not None:
             objective = row.get("objective")
@@ -175,15 +196,63 @@ def benchmark(problem_or_scenarios, solvers, seeds=None, time_limit_s: float | N
     table = pd.DataFrame.from_records(rows, columns=COLUMNS)
     for column in ("objective", "bound", "gap", "total_delay_s", "avg_delay_s", "wall_seconds", "solve_seconds", "build_seconds"):
         table[column] = table[column].astype("float64")
+    table["plan_seed"] = table["plan_seed"].astype("Int64")
     return table
 
 
+def _against(args):
+    """``--against FILE`` read and checked before anything runs (None without it); with
+    ``--update`` a FILE that does not exist yet is an empty one, created at the end."""
+    import os
+
+    from uamopt.experiments.results import Results, read_results
+
+    against, update = getattr(args, "against", None), getattr(args, "update", False)
+    if update and not against:
+        raise UamoptError("--update needs --against FILE", "--update",
+                          "name the results file to update: --against benchmarks/results.json --update")
+    if not against:
+        return None
+    if args.flights or args.network:
+        raise UamoptError("--against compares instances the results file can name (scenario, --set, plan seed); a "
+                          "--flights or --network instance is not one", "--against",
+                          "bench the scenario's generated plan (--seed picks it), or leave out --against")
+    path = Path(against)
+    folder = path.parent
+    if update and not (folder.is_dir() and os.access(folder, os.W_OK | os.X_OK)):  # the file is replaced from there
+        raise UamoptError(f"cannot write the results file {path}: its folder does not exist or is not writable",
+                          "--update", "create the folder first, or give another path")
+    return read_results(path) if path.exists() or not update else Results()
+
+
+def _record(args, table_path: Path) -> None:
+    """``--update``: the bench.csv just written merged into the results file; one line each."""
+    import sys
+
+    from uamopt.errors import printable
+    from uamopt.experiments.results import update_results
+
+    changes, skipped = update_results(args.against, table_path)
+    for line in changes:
+        print(printable(f"results: {args.against}: {line}"))
+    if not changes:
+        print(printable(f"results: {args.against} unchanged (no verified run improves it)"))
+    for line in skipped:
+        sys.stderr.write(f"warning: {printable(f'not recorded in {args.against}: {line}')}\n")
+
+
 def cmd_bench(args) -> int:
-    """``uamopt bench``: the instances of the scenarios (or --flights), every profile × seed."""
+    """``uamopt bench``: the instances of the scenarios (or --flights), every profile × seed;
+    ``--against FILE`` compares each run with the best known values, ``--update`` records them."""
+    import sys
+
+    from uamopt.errors import printable
     from uamopt.experiments.bench_report import write_bench
+    from uamopt.experiments.results import compare
     from uamopt.outputs import output_lock
     from uamopt.scenario import load_scenario
 
+    results = _against(args)  # before anything runs or is written
     seeds = None
     if args.seeds:
         seeds = list(range(args.seeds[0])) if len(args.seeds) == 1 else list(args.seeds)
@@ -196,19 +265,29 @@ def cmd_bench(args) -> int:
         raise UamoptError("--set, --flights and --network do not apply to an airland file", airland[0],
                           "bench airland files on their own, or scenarios with those options")
     scenarios = {path: load_scenario(path, args.set) for path in args.scenario if path not in airland}
-    with output_lock(args.out):  # held from the first instance to the written report
-        instances = {}
+    with output_lock(args.out):  # held from the first instance to the written report (and results file)
+        instances, sources = {}, {}
         for path in args.scenario:
             if path in airland:
                 from uamopt.schedule.airland import read_airland
 
                 name, problem = Path(path).stem, read_airland(path)
+                source = {"plan_seed": None, "scenario": path, "set": []}
             else:
-                name, problem = instance_name(scenarios[path], args.set), _cli_problem(scenarios[path], args)
-            instances[name if name not in instances else f"{name}#{len(instances) + 1}"] = problem
-        table = benchmark(instances, profiles, seeds=seeds)
-        text = write_bench(args.out, table)
-    print(text)
+                scenario = scenarios[path]
+                name, problem = instance_name(scenario, args.set), _cli_problem(scenario, args)
+                plan_seed = None if args.flights else scenario.schedule.plan_seed if args.seed is None else args.seed
+                source = {"plan_seed": plan_seed, "scenario": path, "set": list(args.set)}
+            name = name if name not in instances else f"{name}#{len(instances) + 1}"
+            instances[name], sources[name] = problem, source
+        table = benchmark(instances, profiles, seeds=seeds, sources=sources)
+        comparison = compare(table, results, str(args.against)) if results is not None else None
+        text = write_bench(args.out, comparison.table if comparison is not None else table, comparison)
+        print(text)
+        for line in comparison.warnings() if comparison is not None else []:
+            sys.stderr.write(f"warning: {printable(line)}\n")
+        if results is not None and args.update:
+            _record(args, Path(args.out) / "bench.csv")
     return 0 if bool(table["verified"].fillna(False).all()) else 1
 
 

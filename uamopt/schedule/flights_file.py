@@ -19,7 +19,6 @@ both flown at that rate; the rest at ``speed_mps``.
 
 from __future__ import annotations
 
-import json
 import math
 from collections.abc import Mapping
 from dataclasses import replace
@@ -37,7 +36,7 @@ from uamopt.bounds import (
     check_cell,
     check_number,
     check_points,
-    parse_error,
+    read_json,
 )
 from uamopt.errors import InputFileError
 from uamopt.schedule.flights import DEFAULT_SERVICE_S, TIME_TOL_S, Flight, FlightSet, round_half_up, track_length_m
@@ -186,22 +185,7 @@ def load_flights(
     source = str(path)
     if not path.is_file():
         raise InputFileError(f"flights file not found: {path}", source, "give the path of a flights.json")
-    try:
-        raw = json.loads(path.read_text(encoding="utf-8-sig"))
-    except json.JSONDecodeError as exc:
-        raise InputFileError(f"malformed JSON: {exc.msg} at line {exc.lineno} column {exc.colno}", source,
-                             "fix the syntax") from None
-    except UnicodeDecodeError:
-        raise InputFileError("flights file is not UTF-8 text", source, "save it as UTF-8 JSON") from None
-    except ValueError as exc:  # an integer of more than 4300 digits (Python's int-string limit)
-        raise InputFileError(f"malformed JSON: {parse_error(exc)}", source, "write every number in its range "
-                             "(docs/interfaces.md, flights.json)") from None
-    except RecursionError:
-        raise InputFileError("the flights file is nested too deeply to read", source, "give a flights.json as "
-                             "docs/interfaces.md describes") from None
-    except OSError as exc:
-        raise InputFileError(f"cannot read the flights file: {exc.strerror or exc}", source,
-                             "check that the file is readable") from None
+    raw = read_json(path, "the flights file", source, "a flights.json as docs/interfaces.md describes")
     if not isinstance(raw, dict) or not isinstance(raw.get("flights"), list):
         raise InputFileError("missing key 'flights' (a list)", source,
                              'write {"cell": [...], "conflict_radius": r, "flights": [...]}')

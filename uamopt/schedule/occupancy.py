@@ -42,6 +42,7 @@ the flight pairs whose departure windows can meet are matched to their track pai
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from typing import overload
 
@@ -370,7 +371,7 @@ def conflict_table(flightset: FlightSet, *, max_track_pairs: int = MAX_TRACK_PAI
             return ConflictTable.empty()
         p, q = np.divmod(pair_code, len(flightset))
         grp = np.arange(len(pair_code))
-    return _prune_to_ranges(flightset, p, q, grp, pair_code, ptr, lo, hi)
+    return dataclasses.replace(_prune_to_ranges(flightset, p, q, grp, pair_code, ptr, lo, hi), from_tracks=True)
 
 
 def _prune_to_ranges(flightset, p, q, grp, pair_code, ptr, lo, hi) -> ConflictTable:
@@ -420,6 +421,10 @@ class ConflictTable:
     q: np.ndarray
     ptr: np.ndarray
     intervals: np.ndarray
+    #: computed by :func:`conflict_table` from the flight set's own tracks (every conflict of the
+    #: occupancy rule is in it): the time-indexed model may then derive clique rows from the
+    #: geometry (uamopt/solvers/cliques.py); False for any other table
+    from_tracks: bool = False
 
     @classmethod
     def empty(cls) -> ConflictTable:

@@ -82,7 +82,8 @@ OWN: dict[str, dict[str, Opt]] = {
     "timeindexed": {"step_s": Opt(float, 10.0, valid=STEP_S), "model": Opt(str, "grid", choices=("grid", "relaxed")),
                     "engine": Opt(str, "auto", choices=("auto", "highs", "cpsat", "hybrid")),
                     "warm_soa_s": Opt(float, 0.0, valid=SECONDS), "continuous_bound_s": Opt(float, 0.0, valid=SECONDS),
-                    "continuous_bound_step_s": POSITIVE_S, "mip_rel_gap": Opt(float, 0.0, valid=Range(0.0, 1e6))},
+                    "continuous_bound_step_s": POSITIVE_S, "mip_rel_gap": Opt(float, 0.0, valid=Range(0.0, 1e6)),
+                    "cliques": Opt(bool, True), "refine_step_s": Opt(float, 0.0, valid=Range(0.0, MAX_TIME_S))},
 }
 #: solvers that hand every other option to the underlying library, after checking it there
 PASS_THROUGH = {"highs": "HiGHS", "cpsat": "CP-SAT"}

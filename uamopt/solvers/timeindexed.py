@@ -56,9 +56,11 @@ the far better bound; the better incumbent and the larger bound of the two, both
 
 Options: ``step_s`` (s, default 10), ``model`` ("grid" | "relaxed", default "grid"), ``engine``
 ("auto" | "highs" | "cpsat" | "hybrid", default "auto"), ``warm_soa_s`` (seconds of SOA in the warm start, default 0),
-``continuous_bound_s`` (default 0: seconds to spend after a ``grid`` solve on the ``relaxed``
+``continuous_bound_s`` (default 0: seconds kept, at most half the limit, for after a ``grid`` solve on the ``relaxed``
 model at ``continuous_bound_step_s`` (default ``step_s``), whose bound is reported as
-``extras["continuous_bound"]``), ``mip_rel_gap`` (default 0). The summary names the model:
+``extras["continuous_bound"]``), ``mip_rel_gap`` (default 0), ``cliques`` (default true: the clique
+rows of cliques.py), ``refine_step_s`` (default 0: none; coarse to fine, :func:`_refine`: 40 % of the
+engine's time on the ``step_s`` grid, the rest on the finer grid started from its best). The summary names the model:
 ``extras["model"]`` = e.g. "delay grid 10 s (exact for delays on the grid)".
 Status: from the engine's own termination — ``optimal`` (proved on the named model),
 ``time_limit``; never inferred from elapsed time.
@@ -76,7 +78,7 @@ import numpy as np
 from uamopt.errors import UamoptError
 from uamopt.interrupts import stopping
 from uamopt.schedule.flights import TIME_TOL_S
-from uamopt.schedule.model import Schedule, SchedulingProblem, Status, make_schedule
+from uamopt.schedule.model import Schedule, SchedulingProblem, Status, evaluate, make_schedule
 from uamopt.solvers.highs import highs_can_start, mip_solver, run_mip, start_solution
 from uamopt.solvers.warmstart import Start, no_schedule, no_worse, reduced, warm_start
 
@@ -106,6 +108,8 @@ class GridModel:
     cap_ptr: np.ndarray = field(default_factory=lambda: np.zeros(1, np.int64))
     cap_col: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
     cap_rhs: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    cliques: int = 0  # clique rows among the "≤ 1" rows (cliques.py), after the pair rows
+    dominated_pair_rows: int = 0  # pair rows dropped because a clique row implies them
 
     @property
     def n_cols(self) -> int:
@@ -209,12 +213,14 @@ def _capacity_rows(problem: SchedulingProblem, step_s: float, kind: str, k_max: 
     return np.asarray(ptr, dtype=np.int64), cols_all, np.asarray(rhs, dtype=float)
 
 
-def build_grid_model(problem: SchedulingProblem, step_s: float = 10.0, kind: str = "grid", both_ways: bool = False
-                     ) -> GridModel:
+def build_grid_model(problem: SchedulingProblem, step_s: float = 10.0, kind: str = "grid", both_ways: bool = False,
+                     cliques: bool = False) -> GridModel:
     """The time-indexed model of the module docstring, vectorised over pairs and delay indices.
 
     ``both_ways`` also writes each pair's rows from q's side (x_{q,b} + Σ_{a: b − a ∈ Z} x_{p,a} ≤ 1):
-    twice the rows, a tighter relaxation for CP-SAT's propagation and LP."""
+    twice the rows, a tighter relaxation for CP-SAT's propagation and LP. ``cliques`` adds the
+    occupancy's clique rows and drops the pair rows one of them implies (cliques.py): the same
+    integer points, a far tighter LP."""
     if kind not in ("grid", "relaxed"):
         raise UamoptError(f"unknown time-indexed model '{kind}'", "solver timeindexed", "use model = \"grid\" or \"relaxed\"")
     if not (math.isfinite(step_s) and step_s > 0):
@@ -261,11 +267,25 @@ def build_grid_model(problem: SchedulingProblem, step_s: float = 10.0, kind: str
     assign_ptr = np.concatenate([[0], np.cumsum(k_max[multi] + 1)]).astype(np.int64)
     row_ptr = np.concatenate([assign_ptr, assign_ptr[-1] + pair_ptr[1:]])
     row_col = np.concatenate([assign_cols, col]).astype(np.int64)
+    n_cliques = n_dominated = 0
+    if cliques:  # clique rows from the occupancy (cliques.py); the pair rows they imply dropped
+        from uamopt.solvers.cliques import dominated, occupancy_cliques
+
+        clique_ptr, clique_col = occupancy_cliques(problem, start, step_s, kind)
+        n_cliques = len(clique_ptr) - 1
+        if n_cliques:
+            drop = dominated(pair_ptr, col, clique_ptr, clique_col, int(start[-1]))
+            n_dominated = int(drop.sum())
+            sizes = np.diff(pair_ptr)[~drop]
+            col = col[~np.repeat(drop, np.diff(pair_ptr))]
+            pair_ptr = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
+            row_ptr = np.concatenate([assign_ptr, assign_ptr[-1] + pair_ptr[1:], assign_ptr[-1] + pair_ptr[-1] + clique_ptr[1:]])
+            row_col = np.concatenate([assign_cols, col, clique_col]).astype(np.int64)
     prec = [(f, group) for family in problem.of_shape("precedence") for f, group in family.groups()]
     cap_ptr, cap_col, cap_rhs = _capacity_rows(problem, step_s, kind, k_max, start)
     return GridModel(step_s=float(step_s), kind=kind, start=start, cost=cost, row_ptr=row_ptr, row_col=row_col, prec=prec,
                      must=np.flatnonzero(problem.must_operate).astype(np.int64), cap_ptr=cap_ptr, cap_col=cap_col,
-                     cap_rhs=cap_rhs)
+                     cap_rhs=cap_rhs, cliques=n_cliques, dominated_pair_rows=n_dominated)
 
 
 def model_name(kind: str, step_s: float) -> str:
@@ -447,6 +467,47 @@ def _grid_is_exact(problem: SchedulingProblem, step_s: float) -> bool:
 
 
 # --- the solver ------------------------------------------------------------------------------------
+REFINE_COARSE_SHARE = 0.4  # refine_step_s > 0: this share of the engine's time to the coarse grid
+REFINE_MIN_S = 5.0  # no refinement with less time than this for the finer grid
+#: no refinement to a grid of more columns: models/benchmark_1000.toml's 5 s grid (25,500 columns,
+#: 373,000 rows with its cliques) gave the best schedule in 300 s; the 3,000-flight rung's (76,500) would
+#: take minutes and gigabytes to build
+REFINE_MAX_COLUMNS = 40_000
+
+
+def _columns(problem: SchedulingProblem, step_s: float) -> int:
+    """The number of columns of the grid model of ``step_s``."""
+    return int(np.sum(np.floor(problem.delay_upper_s / step_s + ETA_S / step_s) + 1))
+
+
+def _refine(small: SchedulingProblem, problem: SchedulingProblem, profile: SolverProfile, coarse: GridModel,
+            result: EngineResult, start: Start, fine_step: float, engine: str, gap: float, deadline: float
+            ) -> tuple[GridModel, EngineResult, str]:
+    """Coarse to fine: the grid model of ``fine_step`` started from the coarse grid's best point (a
+    point of the fine grid when the coarse step is a multiple of the fine one). Returns the model and
+    result to report: the fine one when it gave a schedule no worse than the coarse one's, else the coarse."""
+    left = deadline - time.perf_counter()
+    if left < REFINE_MIN_S:
+        return coarse, result, f"not run: {left:.0f} s left after the {coarse.step_s:g} s grid (needs {REFINE_MIN_S:g})"
+    decisions = coarse.decode(result.x) if result.x is not None else start.decisions
+    if result.x is not None and start.found and start.objective < evaluate(problem, *decisions) - 1e-12:
+        decisions = start.decisions
+    t = time.perf_counter()
+    fine = build_grid_model(small, fine_step, "grid", both_ways=engine == "cpsat", cliques=profile.option("cliques"))
+    hint = fine.columns_of(*decisions)
+    second = run_engine(engine, fine, problem, max(0.1, deadline - time.perf_counter()), profile.threads, profile.seed,
+                        gap, hint)
+    took = time.perf_counter() - t
+    if second.x is None:
+        return coarse, result, (f"{fine_step:g} s grid: no schedule in {took:.0f} s ({second.termination}); "
+                                f"the {coarse.step_s:g} s grid's kept")
+    coarse_value = float(coarse.cost @ result.x) if result.x is not None else math.inf
+    if float(fine.cost @ second.x) > coarse_value + 1e-9 * (1.0 + abs(coarse_value)):
+        return coarse, result, f"{fine_step:g} s grid: worse in {took:.0f} s; the {coarse.step_s:g} s grid's kept"
+    return fine, second, (f"{coarse.step_s:g} s grid {coarse_value:.6f}, then the {fine_step:g} s grid from it "
+                          f"({took:.0f} s, {fine.n_cols} columns, {fine.cliques} cliques)")
+
+
 def solve(problem: SchedulingProblem, profile: SolverProfile) -> Schedule:
     """Build the time-indexed model, warm-start it, solve it; see the module docstring."""
     o = profile.option  # typed and checked by the profile (uamopt.solvers.options)
@@ -454,18 +515,37 @@ def solve(problem: SchedulingProblem, profile: SolverProfile) -> Schedule:
     t0 = time.perf_counter()
     start: Start = warm_start(problem, step, soa_s=o("warm_soa_s"), seed=profile.seed, on_grid=True)
     small = reduced(problem)  # dominance caps: the same optima (warmstart.py)
-    if engine == "auto":  # measured (docs/exact_scheduling.md): HiGHS proves ≤ 600 flights, CP-SAT gets further beyond
-        engine = "highs" if int(np.sum(np.floor(small.delay_upper_s / step) + 1)) <= AUTO_HIGHS_COLUMNS else "hybrid"
-    model = build_grid_model(small, step, kind, both_ways=engine == "cpsat")
+    model = build_grid_model(small, step, kind, both_ways=engine == "cpsat", cliques=o("cliques"))
+    if engine == "auto":  # measured (docs/exact_scheduling.md): with clique rows HiGHS leads at every rung;
+        # without them HiGHS proves ≤ 600 flights and CP-SAT's merged cliques get further beyond
+        engine = "highs" if model.cliques or model.n_cols <= AUTO_HIGHS_COLUMNS else "hybrid"
     built = time.perf_counter() - t0
     hint = model.columns_of(*start.decisions) if kind == "grid" and start.found else None
+    refine = o("refine_step_s")
+    cont_s = min(cont_s, 0.5 * profile.time_limit_s)  # a short limit: the grid keeps half of it
     limit = max(0.1, profile.time_limit_s - built - cont_s)
-    result = run_engine(engine, model, problem, limit, profile.threads, profile.seed, gap, hint)
+    refining = (kind == "grid" and 0 < refine < step and _columns(small, refine) <= REFINE_MAX_COLUMNS
+                and limit * (1 - REFINE_COARSE_SHARE) >= REFINE_MIN_S)
+    result = run_engine(engine, model, problem, limit * (REFINE_COARSE_SHARE if refining else 1.0), profile.threads,
+                        profile.seed, gap, hint)
+    coarse_termination = result.termination
+    if refining and (result.x is not None or start.found):  # even a coarse optimum: the finer grid holds more
+        model, result, fine_note = _refine(small, problem, profile, model, result, start, refine, engine, gap,
+                                           t0 + profile.time_limit_s - cont_s)
+        step = model.step_s
+    else:
+        fine_note = None
     extras = {"model": model_name(kind, step), "engine": engine, "termination": result.termination,
-              "columns": model.n_cols, "rows": model.n_rows, "build_seconds": round(built, 3),
+              "columns": model.n_cols, "rows": model.n_rows, "cliques": model.cliques,
+              "dominated_pair_rows": model.dominated_pair_rows, "build_seconds": round(built, 3),
               "warm_start": f"{start.source} {start.objective:.6f}", "warm_start_s": round(start.seconds, 3),
               "engine_first_incumbent_s": result.first_incumbent_s, "engine_best_incumbent_s": result.best_incumbent_s,
               "engine_seconds": round(result.seconds, 3)}
+    if kind == "grid" and 0 < refine < step and not refining:
+        extras["refined"] = (f"not run: the {refine:g} s grid would have {_columns(small, refine)} columns (at most "
+                             f"{REFINE_MAX_COLUMNS}), or less than {REFINE_MIN_S:g} s would be left for it")
+    if fine_note is not None:
+        extras.update(refined=fine_note, coarse_termination=coarse_termination, model_kind=f"delay grid {step:g} s")
     n = problem.n_flights
     if result.x is None and "infeasible" in result.termination.lower() and not len(model.cap_rhs):
         # infeasible on the grid, a restriction: the continuous MILP (milp.py) decides, in the time left
@@ -506,7 +586,7 @@ def solve(problem: SchedulingProblem, profile: SolverProfile) -> Schedule:
     schedule = no_worse(problem, schedule, start)
     if cont_s > 0:
         c_step = o("continuous_bound_step_s", step)
-        relaxed = build_grid_model(reduced(problem), c_step, "relaxed")
+        relaxed = build_grid_model(reduced(problem), c_step, "relaxed", cliques=o("cliques"))
         left = max(0.1, profile.time_limit_s - (time.perf_counter() - t0))
         r = run_engine(engine, relaxed, problem, left, profile.threads, profile.seed, gap, None)
         schedule.extras.update(continuous_bound=r.bound, continuous_bound_model=model_name("relaxed", c_step),
