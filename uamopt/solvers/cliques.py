@@ -4,8 +4,9 @@ Why
 ---
 The time-indexed model's conflict rows are pairwise (timeindexed.py: x_{p,a} + Σ_{b ∈ a+Z} x_{q,b}
 ≤ 1). Where several flights want one piece of airspace at about one time, the LP relaxation sets
-each of them to ½ in two slots and every pair row holds: on planned tracks in a dense city the LP
-bound of the 1,000-flight instances lay 35 % below the best schedule. The aircraft-landing
+each of them to ½ in two slots and every pair row holds: on a 1,000-flight paper-case plan the LP
+bound of the 10 s grid lay 51 % below the best schedule on that grid (−338.5 against −223.5; with
+the rows −263.3, docs/exact_scheduling.md). The aircraft-landing
 literature closes this with clique inequalities on time-indexed models (the facets of right-hand
 side 1 are the maximal cliques of the column conflict graph); here the cliques come from the
 geometry, so no clique search on a graph of 10⁵ columns is needed.
@@ -35,7 +36,8 @@ one instant): a start followed by an end closes a maximal clique. Identical cliq
 blocks are kept once; cliques of a single flight (implied by its assignment row) are dropped.
 
 Dominated rows: a pair row whose columns all lie in one clique row is implied by it and is
-removed (:func:`dominated`), which more than halves the 1,000-flight model.
+removed (:func:`dominated`): on a 1,000-flight paper-case plan 70,791 of its 121,397 pair rows
+(10 s grid); on models/benchmark_1000.toml 35,863 of 60,224, for 53,267 clique rows.
 
 When
 ----

@@ -435,6 +435,7 @@ def solve(problem: SchedulingProblem, profile: SolverProfile, extra=None) -> Sch
     m = build_model(reduced(problem), extra)  # delay bounds capped by dominance: the same optima (warmstart.py)
     build_s = time.perf_counter() - t0
     solver.set_instance(m)  # the persistent interface: load the model, then hand HiGHS the MIP start
+    _own_thread_pool(solver)
     if start.found:
         _set_mip_start(solver, mip_start(m, problem, *start.decisions))
     stopped: list = []
@@ -535,6 +536,15 @@ def _stale_solution(m: pyo.ConcreteModel, result) -> bool:
     return abs(pyo.value(m.objective) - result.incumbent_objective) > 1e-6 * (1.0 + abs(result.incumbent_objective))
 
 
+def _own_thread_pool(solver) -> None:
+    """HiGHS keeps one thread pool per process, sized by the first run: a later run asking for
+    more threads stops at once with model status "Not Set" (seen after a 1-thread time-indexed
+    solve in the same process, with no MIP start to reset it). Reset it before every solve."""
+    highs = getattr(solver, "_solver_model", None)
+    if highs is not None:
+        highs.resetGlobalScheduler(True)
+
+
 def _set_mip_start(solver, values: dict) -> None:
     """``Highs.setSolution`` on the persistent Pyomo interface's HiGHS model (pyomo 6.10: the column
     of a variable is ``_pyomo_var_to_solver_var_map[id(var)]``). Without that map (another Pyomo
@@ -544,7 +554,6 @@ def _set_mip_start(solver, values: dict) -> None:
     highs = getattr(solver, "_solver_model", None)
     if not index or highs is None:
         return
-    highs.resetGlobalScheduler(True)  # one HiGHS thread pool per process: let this solve set its own thread count
     x = np.zeros(highs.getNumCol())
     for var_id, value in values.items():
         col = index.get(var_id)

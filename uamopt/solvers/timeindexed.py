@@ -68,6 +68,7 @@ Status: from the engine's own termination — ``optimal`` (proved on the named m
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from dataclasses import dataclass, field
@@ -469,6 +470,7 @@ def _grid_is_exact(problem: SchedulingProblem, step_s: float) -> bool:
 # --- the solver ------------------------------------------------------------------------------------
 REFINE_COARSE_SHARE = 0.4  # refine_step_s > 0: this share of the engine's time to the coarse grid
 REFINE_MIN_S = 5.0  # no refinement with less time than this for the finer grid
+BOUND_MIN_STEP_S = 1.0  # the continuous bound's cells are halved down to this width at most, s
 #: no refinement to a grid of more columns: models/benchmark_1000.toml's 5 s grid (25,500 columns,
 #: 373,000 rows with its cliques) gave the best schedule in 300 s; the 3,000-flight rung's (76,500) would
 #: take minutes and gigabytes to build
@@ -549,8 +551,6 @@ def solve(problem: SchedulingProblem, profile: SolverProfile) -> Schedule:
     n = problem.n_flights
     if result.x is None and "infeasible" in result.termination.lower() and not len(model.cap_rhs):
         # infeasible on the grid, a restriction: the continuous MILP (milp.py) decides, in the time left
-        import dataclasses
-
         from uamopt.solvers import milp
 
         left = max(0.1, profile.time_limit_s - (time.perf_counter() - t0))
@@ -591,6 +591,20 @@ def solve(problem: SchedulingProblem, profile: SolverProfile) -> Schedule:
         r = run_engine(engine, relaxed, problem, left, profile.threads, profile.seed, gap, None)
         schedule.extras.update(continuous_bound=r.bound, continuous_bound_model=model_name("relaxed", c_step),
                                continuous_bound_termination=r.termination)
+        # coarse to fine for the bound too: while a relaxation is proved with time left, the cells of half
+        # the width (each one's optimum is a bound of the continuous problem; the largest is kept)
+        while (r.proved and o("refine_step_s") > 0 and c_step / 2 >= BOUND_MIN_STEP_S
+               and _columns(reduced(problem), c_step / 2) <= REFINE_MAX_COLUMNS
+               and profile.time_limit_s - (time.perf_counter() - t0) >= REFINE_MIN_S):
+            c_step /= 2
+            finer = build_grid_model(reduced(problem), c_step, "relaxed", cliques=o("cliques"))
+            left = max(0.1, profile.time_limit_s - (time.perf_counter() - t0))
+            r = run_engine(engine, finer, problem, left, profile.threads, profile.seed, gap, None)
+            if r.bound is not None and (schedule.extras["continuous_bound"] is None
+                                        or r.bound > schedule.extras["continuous_bound"]):
+                schedule.extras.update(continuous_bound=r.bound, continuous_bound_model=model_name("relaxed", c_step),
+                                       continuous_bound_termination=r.termination)
+        r = dataclasses.replace(r, bound=schedule.extras["continuous_bound"])
         if r.bound is not None and schedule.objective is not None:
             schedule.extras["optimal_within"] = schedule.objective - r.bound
         schedule = make_schedule(problem, "timeindexed", schedule.status, schedule.operated, schedule.delay_s,
