@@ -141,6 +141,11 @@ class GridModel:
         return operated, delay
 
 
+def delay_indices(problem: SchedulingProblem, step_s: float) -> np.ndarray:
+    """K_f = ⌊U_f / s⌋ (round-off ``ETA_S`` forgiven): each flight's largest delay index on the grid of ``step_s``."""
+    return np.floor(problem.delay_upper_s / step_s + ETA_S / step_s).astype(np.int64)
+
+
 def _forbidden_steps(problem: SchedulingProblem, step_s: float, kind: str, k_max: np.ndarray):
     """(p, q, z_lo, z_hi): the integer intervals of forbidden z = k_q − k_p, conflicts then turnarounds."""
     eta = ETA_S / step_s
@@ -228,7 +233,7 @@ def build_grid_model(problem: SchedulingProblem, step_s: float = 10.0, kind: str
         raise UamoptError(f"step_s must be positive, got {step_s}", "solver timeindexed",
                           "give the delay grid step in s, e.g. 10")
     n = problem.n_flights
-    k_max = np.floor(problem.delay_upper_s / step_s + ETA_S / step_s).astype(np.int64)
+    k_max = delay_indices(problem, step_s)
     start = np.concatenate([[0], np.cumsum(k_max + 1)]).astype(np.int64)
     flight_of_col = np.repeat(np.arange(n), k_max + 1)
     k_of_col = np.arange(start[-1]) - start[flight_of_col]
@@ -463,7 +468,7 @@ def _grid_is_exact(problem: SchedulingProblem, step_s: float) -> bool:
     cpsat.py (every time of the data a multiple of s, the objective's integer scaling exact)."""
     from uamopt.solvers.cpsat import integer_objective, lattice_is_exact
 
-    k_max = np.floor(problem.delay_upper_s / step_s + ETA_S / step_s).astype(np.int64)
+    k_max = delay_indices(problem, step_s)
     return lattice_is_exact(problem, step_s, integer_objective(problem, step_s, k_max)[3])
 
 
@@ -479,7 +484,7 @@ REFINE_MAX_COLUMNS = 40_000
 
 def _columns(problem: SchedulingProblem, step_s: float) -> int:
     """The number of columns of the grid model of ``step_s``."""
-    return int(np.sum(np.floor(problem.delay_upper_s / step_s + ETA_S / step_s) + 1))
+    return int(np.sum(delay_indices(problem, step_s) + 1))
 
 
 def _refine(small: SchedulingProblem, problem: SchedulingProblem, profile: SolverProfile, coarse: GridModel,
@@ -586,7 +591,7 @@ def solve(problem: SchedulingProblem, profile: SolverProfile) -> Schedule:
     schedule = no_worse(problem, schedule, start)
     if cont_s > 0:
         c_step = o("continuous_bound_step_s", step)
-        relaxed = build_grid_model(reduced(problem), c_step, "relaxed", cliques=o("cliques"))
+        relaxed = build_grid_model(small, c_step, "relaxed", cliques=o("cliques"))
         left = max(0.1, profile.time_limit_s - (time.perf_counter() - t0))
         r = run_engine(engine, relaxed, problem, left, profile.threads, profile.seed, gap, None)
         schedule.extras.update(continuous_bound=r.bound, continuous_bound_model=model_name("relaxed", c_step),
@@ -594,10 +599,10 @@ def solve(problem: SchedulingProblem, profile: SolverProfile) -> Schedule:
         # coarse to fine for the bound too: while a relaxation is proved with time left, the cells of half
         # the width (each one's optimum is a bound of the continuous problem; the largest is kept)
         while (r.proved and o("refine_step_s") > 0 and c_step / 2 >= BOUND_MIN_STEP_S
-               and _columns(reduced(problem), c_step / 2) <= REFINE_MAX_COLUMNS
+               and _columns(small, c_step / 2) <= REFINE_MAX_COLUMNS
                and profile.time_limit_s - (time.perf_counter() - t0) >= REFINE_MIN_S):
             c_step /= 2
-            finer = build_grid_model(reduced(problem), c_step, "relaxed", cliques=o("cliques"))
+            finer = build_grid_model(small, c_step, "relaxed", cliques=o("cliques"))
             left = max(0.1, profile.time_limit_s - (time.perf_counter() - t0))
             r = run_engine(engine, finer, problem, left, profile.threads, profile.seed, gap, None)
             if r.bound is not None and (schedule.extras["continuous_bound"] is None
