@@ -135,3 +135,7 @@ def test_the_clique_rows_keep_the_grid_optimum_of_a_dense_instance(dense_problem
         assert results[cliques].status == "optimal_on_grid"
     assert results[True].objective == pytest.approx(results[False].objective, abs=OBJ_TOL)
     assert results[True].extras["cliques"] > 0 and results[True].extras["dominated_pair_rows"] > 0
+    # the option acts: off, the model is the pair rows alone (more rows: the dropped ones are back)
+    assert results[False].extras["cliques"] == 0 and results[False].extras["dominated_pair_rows"] == 0
+    assert results[False].extras["rows"] == results[True].extras["rows"] - results[True].extras["cliques"] \
+        + results[True].extras["dominated_pair_rows"]
