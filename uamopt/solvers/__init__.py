@@ -39,6 +39,7 @@ SOLVERS = {
     "cpsat": "uamopt.solvers.cpsat",
     "rolling": "uamopt.solvers.rolling",
     "timeindexed": "uamopt.solvers.timeindexed",
+    "discovery": "uamopt.solvers.discovery",
 }
 #: the shipped profiles (package data, read with importlib.resources: :func:`uamopt.shipped.profiles_dir`)
 PROFILE_DIR = profiles_dir()
@@ -244,6 +245,8 @@ def model_kind(profile: SolverProfile, problem: SchedulingProblem) -> str:
     if profile.solver == "timeindexed":
         step = float(o("step_s"))
         return f"delay grid {step:g} s" if o("model") == "grid" else f"delay cells {step:g} s (relaxation)"
+    if profile.solver == "discovery":
+        return "continuous"
     if profile.solver == "rolling":
         return f"time windows ({o('inner') or 'cpsat'}), heuristic"
     if o("exact_gaps"):

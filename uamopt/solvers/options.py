@@ -84,6 +84,9 @@ OWN: dict[str, dict[str, Opt]] = {
                     "warm_soa_s": Opt(float, 0.0, valid=SECONDS), "continuous_bound_s": Opt(float, 0.0, valid=SECONDS),
                     "continuous_bound_step_s": POSITIVE_S, "mip_rel_gap": Opt(float, 0.0, valid=Range(0.0, 1e6)),
                     "cliques": Opt(bool, True), "refine_step_s": Opt(float, 0.0, valid=Range(0.0, MAX_TIME_S))},
+    "discovery": {"step_s": Opt(float, 10.0, valid=STEP_S), "mip_rel_gap": Opt(float, 0.005, valid=Range(0.0, 1.0)),
+                  "cliques": Opt(bool, True), "lns_share": Opt(float, 0.15, valid=Range(0.0, 1.0)),
+                  "lns_window": Opt(int, 80, valid=Range(2, 10**6, integer=True))},
 }
 #: solvers that hand every other option to the underlying library, after checking it there
 PASS_THROUGH = {"highs": "HiGHS", "cpsat": "CP-SAT"}

@@ -318,17 +318,17 @@ def _left(deadline: float) -> float:
     return max(0.05, deadline - time.perf_counter())
 
 
-def _highs(model: GridModel, deadline: float, threads: int, seed: int, gap: float, hint: np.ndarray | None,
-           presolve: bool = True) -> EngineResult:
+def load_model(h, model: GridModel, integer: bool) -> None:
+    """Load a :class:`GridModel` into ``highspy.Highs`` ``h``: 0-1 columns (continuous in [0, 1]
+    unless ``integer``), its "≤ 1", precedence, must-operate and capacity rows."""
     import highspy
 
-    # at 1,000 flights HiGHS's presolve took the whole limit; without it HiGHS finds incumbents fast
-    h = mip_solver(threads, seed, gap, presolve)
     n = model.n_cols
     inf = highspy.kHighsInf
     h.addVars(n, np.zeros(n), np.ones(n))
     h.changeColsCost(n, np.arange(n, dtype=np.int32), model.cost)
-    h.changeColsIntegrality(n, np.arange(n, dtype=np.int32), np.full(n, highspy.HighsVarType.kInteger))
+    if integer:
+        h.changeColsIntegrality(n, np.arange(n, dtype=np.int32), np.full(n, highspy.HighsVarType.kInteger))
     m = len(model.row_ptr) - 1
     h.addRows(m, np.full(m, -inf), np.ones(m), len(model.row_col), model.row_ptr[:-1].astype(np.int32),
               model.row_col.astype(np.int32), np.ones(len(model.row_col)))
@@ -354,6 +354,14 @@ def _highs(model: GridModel, deadline: float, threads: int, seed: int, gap: floa
         c = len(model.cap_rhs)
         h.addRows(c, np.full(c, -inf), model.cap_rhs, len(model.cap_col), model.cap_ptr[:-1].astype(np.int32),
                   model.cap_col.astype(np.int32), np.ones(len(model.cap_col)))
+
+
+def _highs(model: GridModel, deadline: float, threads: int, seed: int, gap: float, hint: np.ndarray | None,
+           presolve: bool = True) -> EngineResult:
+
+    # at 1,000 flights HiGHS's presolve took the whole limit; without it HiGHS finds incumbents fast
+    h = mip_solver(threads, seed, gap, presolve)
+    load_model(h, model, integer=True)
     if hint is not None:
         h.setSolution(start_solution(hint))
     run = run_mip(h, deadline, "solver timeindexed")  # what the model's loading left of the limit
