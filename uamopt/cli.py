@@ -94,6 +94,15 @@ def cmd_schedule(args) -> int:
 
     scenario = _load(args)
     profile = load_profile(args.solver)
+    if args.scheduler:  # the windows solver's tasks on a running Dask cluster
+        import dataclasses
+
+        from uamopt.errors import UamoptError
+
+        if profile.solver != "windows":
+            raise UamoptError(f"--scheduler is for the windows solver, not {profile.solver}", "--scheduler",
+                              "use --solver windows, or drop --scheduler")
+        profile = dataclasses.replace(profile, options={**profile.options, "scheduler": args.scheduler})
     solver_module(profile.solver)  # a solver of an extra not installed: its one line before any work
     problem, s, problems = schedule_folder(scenario, args.out, profile, args.flights, args.network, args.seed, args.set)
     from uamopt.schedule.families.speed import collapse, speed_choice_of
@@ -208,6 +217,8 @@ def build_parser() -> argparse.ArgumentParser:
     sched = command("schedule", cmd_schedule, "schedule the flights: flights.json, schedule.csv, summary.json",
                     "out/schedule", figures=False)
     sched.add_argument("--solver", required=True, metavar="PROFILE", help="solver profile: solvers/NAME.toml or NAME")
+    sched.add_argument("--scheduler", metavar="ADDRESS",
+                       help="the windows solver: a running Dask scheduler, e.g. tcp://127.0.0.1:8786 (default: a local cluster)")
     flight_sources(sched)
     bench = sub.add_parser("bench", help="benchmark solver profiles × seeds on scenarios: bench.csv, bench.md",
                            description="benchmark solver profiles × seeds on scenarios: bench.csv, bench.md")

@@ -40,6 +40,7 @@ SOLVERS = {
     "rolling": "uamopt.solvers.rolling",
     "timeindexed": "uamopt.solvers.timeindexed",
     "discovery": "uamopt.solvers.discovery",
+    "windows": "uamopt.solvers.windows",
 }
 #: the shipped profiles (package data, read with importlib.resources: :func:`uamopt.shipped.profiles_dir`)
 PROFILE_DIR = profiles_dir()
@@ -245,7 +246,7 @@ def model_kind(profile: SolverProfile, problem: SchedulingProblem) -> str:
     if profile.solver == "timeindexed":
         step = float(o("step_s"))
         return f"delay grid {step:g} s" if o("model") == "grid" else f"delay cells {step:g} s (relaxation)"
-    if profile.solver == "discovery":
+    if profile.solver in ("discovery", "windows"):
         return "continuous"
     if profile.solver == "rolling":
         return f"time windows ({o('inner') or 'cpsat'}), heuristic"

@@ -16,44 +16,52 @@ the relaxation put two conflicting flights at delays the continuous model forbid
 
 The relaxation (cells of any widths)
 ------------------------------------
-Flight f's cells are [c_i, c_{i+1}] for its cut points 0 = c_0 < c_1 < … < c_m ≤ U_f (the last cell
-ends at U_f). Binary x_{f,i}: f operates with a delay in cell i, at the cost of the cell's lower end
-(the objective is non-decreasing in the delay: ``weighted`` and ``lexicographic``). Rows, as in
-timeindexed.py but for arbitrary cells:
+Flight f's cells are [c_i, c_{i+1}) for its cut points 0 = c_0 < c_1 < … < c_m ≤ U_f, the last one
+closed, [c_m, U_f]. Binary x_{f,i}: f operates with a delay in cell i, at the cost of the cell's
+lower end (the objective is non-decreasing in the delay: ``weighted`` and ``lexicographic``). Rows,
+as in timeindexed.py but for arbitrary cells:
 
 - Σ_i x_{f,i} ≤ 1, the precedence and must-operate rows;
-- a conflicting pair (p, q) with a forbidden open interval (lo, hi) of z = d_q − d_p: cell a of p and
-  cell b of q are *forbidden together* iff z's whole closed range over them lies inside
-  [lo + τ/2, hi − τ/2] (τ = ``TIME_TOL_S``); written as x_{p,a} + Σ_{b forbidden with a} x_{q,b} ≤ 1
-  (q's cells exclude each other, so the aggregated row is exact for 0-1 points). Since q's cells
-  are sorted, the forbidden b form one run, found by two binary searches;
-- a turnaround row (e, f, need) (d_f − d_e ≥ need): cells forbidden together iff even the largest
-  difference is below need − τ/2;
+- a conflicting pair (p, q) with a forbidden open interval (lo, hi) of z = d_q − d_p: over cell a
+  of p and cell b of q, z ranges over (b_lo − a_hi, b_hi − a_lo), an end included when its cell is
+  a last one. The two cells are *forbidden together* iff that range lies inside (lo, hi) (10⁻⁹ s
+  of float round-off forgiven, ``ROUND_S``); written as x_{p,a} + Σ_{b forbidden with a} x_{q,b}
+  ≤ 1 (q's cells exclude each other, so the aggregated row is exact for 0-1 points). q's cells
+  are sorted, so the b forbidden with a form one run, found by two binary searches;
+- a turnaround row (e, f, need) (d_f − d_e ≥ need): cells forbidden together iff every difference
+  stays below need;
 - the clique rows of cliques.py, derived once on the uniform cells of the first width and *lifted*:
   a column of the first model is replaced by the sum of the cells it was cut into (each a subset of
   it, so every pair of the row still conflicts, and a flight's cells exclude each other).
 
-Every continuous schedule maps to a feasible point (each delay to the cell whose lower end is the
-largest not above it) of no greater cost, since forbidden cell pairs contain only forbidden delay
-pairs. So the relaxation's optimum, and any bound of it, bounds the continuous optimum, for every
-set of cuts.
+Every continuous schedule maps to a feasible point (each delay to the cell holding it) of no
+greater cost, since forbidden cell pairs hold only forbidden delay pairs. So the relaxation's
+optimum, and any bound of it, bounds the continuous optimum, for every set of cuts.
 
 Discovery
 ---------
-Solve the relaxation (HiGHS, warm-started with the best schedule known) and read its point at the
-cells' lower ends. If that point breaks no pair interval or turnaround (as the verifier reads them,
-with tolerance τ), it is a schedule whose cost equals the relaxation's: *optimal* for continuous
-delays when the relaxation was proved optimal. Else, for each broken pair interval with z₀ inside
-(lo + τ, hi − τ), cut p's cell at d_p + (z₀ − lo − ¾τ) and q's at d_q + (hi − ¾τ − z₀): the
-sub-cells holding the two delays are then forbidden together (z ranges over [lo + ¾τ, hi − ¾τ]), and
-the next cells' lower ends put z at lo + ¾τ or hi − ¾τ, which the verifier accepts. A broken
-turnaround cuts f at d_f + (need − ¾τ − z₀). Each round forbids the point found, so the bound never
-falls, and every round's bound is valid. Each round also repairs its point into a schedule (the
-preliminary strategy's decoder, flights in the order of their relaxed departures, each asking for
-its relaxed delay) to keep an incumbent.
+Solve the relaxation (HiGHS, started from the best schedule known) and read its point at the
+cells' lower ends. If that point breaks no pair interval or turnaround (as the verifier reads
+them), it is a schedule whose cost is the relaxation's: *optimal* for continuous delays once a
+round proves it (``mip_rel_gap`` 0). Else, for each broken pair interval with z₀ = d_q − d_p inside
+(lo, hi), p's cell is cut at d_q − lo and q's at d_p + hi: the sub-cells holding the two delays
+are then forbidden together (z ranges over (lo, z₀] and [z₀, hi)), and the next cells' lower ends
+put z exactly at lo or hi, which the model allows. A broken turnaround cuts f at d_e + need. Each
+flight of a broken row is also cut at every gap end on its way to its earliest admissible delay
+(polish.py), so a chain of pushes is seen in one round. A round forbids the point it found, so the
+bound never falls, and every round's bound is valid. Each round's point is also *mended* into a
+schedule (polish.py: the later flight of each broken row taken out and put back at its earliest
+admissible delay, then left shifts and insertions), which keeps an incumbent.
+
+A round's MILP stops at the relative gap ``mip_rel_gap`` while the best schedule is far from the
+bound, at a quarter of that distance once closer, or after ``round_s`` seconds (its bound is then
+HiGHS's dual bound, still valid, and its incumbent gives the cuts), and at 0 with no time cap when
+its point was a schedule (to prove it). Dynamic discretisation discovery is due to Boland, Hewitt,
+Savelsbergh ("The continuous-time service network design problem", Operations Research 65(5), 2017); the cells here are delays, and
+the cuts are the forbidden intervals' ends.
 
 Applies to problems without the ``cumulative`` shape (pads) and with a delay cost non-decreasing
-in the delay (not earliness/tardiness); :func:`applicable` says so.
+in the delay (not earliness/tardiness): :data:`SHAPES`, :data:`OBJECTIVES`.
 """
 
 from __future__ import annotations
@@ -72,13 +80,7 @@ from uamopt.solvers.warmstart import no_worse
 ETA_S = 1e-9  # float round-off forgiven when mapping a delay to its cell, s
 ROUND_S = 1e-9  # float round-off forgiven in the forbidden test, s
 MIN_WIDTH_S = 1e-10  # no cut closer than this to another, s
-
-
-def applicable(problem: SchedulingProblem) -> bool:
-    """Whether the discovery relaxation covers every constraint and the objective (module docstring)."""
-    o = problem.objective
-    return (not o.per_flight_terms and o.per_delay >= 0 and not problem.of_shape("cumulative")
-            and problem.n_flights > 0)
+REPAIR_S = 10.0  # at most this long for a round's exact repair, s
 
 
 @dataclass
@@ -319,6 +321,9 @@ class Round:
     cuts: int
     repaired: float | None
     seconds: float
+    build_s: float = 0.0
+    milp_s: float = 0.0
+    termination: str = ""  # HiGHS's, e.g. "Time limit reached"
 
 
 @dataclass
@@ -337,18 +342,23 @@ class Discovery:
 
 def discover(problem: SchedulingProblem, small: SchedulingProblem, deadline: float, threads: int, seed: int, *,
              step_s: float = 10.0, start: tuple[np.ndarray, np.ndarray] | None = None, gap: float = 0.0,
-             cliques: bool = True, target_gap: float = 0.0, sweep: bool = True,
+             cliques: bool = True, target_gap: float = 0.0, sweep: bool = True, max_rounds: int | None = None,
+             exact_repair: bool = True, state: dict | None = None, round_s: float | None = None,
              log=None) -> Discovery:
     """Rounds of discovery on ``small`` (``problem`` reduced by dominance: the same optima) until
     ``deadline`` (a ``time.perf_counter`` time), the point is a schedule, or the best schedule lies
     within ``target_gap`` (relative) of the bound. Schedules are evaluated on ``problem``."""
+    from uamopt.solvers import lns
     from uamopt.solvers.polish import Neighbours, mend, polish
     from uamopt.solvers.timeindexed import _highs
 
     cons = Constraints.of(small)
     nb = Neighbours(small)
-    cells = Cells.uniform(small, step_s)
-    lifted = lifted_cliques(small, step_s) if cliques else None
+    state = {} if state is None else state  # a later call goes on from an earlier call's cells
+    if "cells" not in state:
+        state["cells"] = Cells.uniform(small, step_s)
+        state["lifted"] = lifted_cliques(small, step_s) if cliques else None
+    cells, lifted = state["cells"], state["lifted"]
     best_x: tuple[np.ndarray, np.ndarray] | None = None
     best_value = math.inf
     if start is not None and not violations(problem, *start):
@@ -358,15 +368,18 @@ def discover(problem: SchedulingProblem, small: SchedulingProblem, deadline: flo
             best_x, best_value = (p_op, p_d), evaluate(problem, p_op, p_d)
         if log is not None:
             log(None, None, best_value)
-    bound: float | None = None
+    bound: float | None = state.get("bound")
     rounds: list[Round] = []
     round_gap = gap
-    while time.perf_counter() < deadline - 0.5:
+    while time.perf_counter() < deadline - 0.5 and (max_rounds is None or len(rounds) < max_rounds):
         t = time.perf_counter()
         model, lower, upper = build(small, cells, cons, lifted)
         st = model.start
         hint = cells.cell_of(best_x[1], best_x[0], st) if best_x is not None else None
-        run = _highs(model, deadline, threads, seed, round_gap, hint)
+        t_built = time.perf_counter()
+        cap = deadline if round_gap == 0.0 or round_s is None else min(deadline, time.perf_counter() + round_s)
+        run = _highs(model, cap, threads, seed, round_gap, hint)
+        t_solved = time.perf_counter()
         if run.bound is not None:  # every round's relaxation bounds the continuous optimum
             bound = run.bound if bound is None else max(bound, run.bound)
         if run.x is None:
@@ -383,11 +396,19 @@ def discover(problem: SchedulingProblem, small: SchedulingProblem, deadline: flo
             if v < best_value:
                 best_x, best_value = (operated, delay), v
         else:
-            r_op, r_d = polish(small, nb, *mend(small, nb, operated, delay))
-            if not violations(problem, r_op, r_d):
-                repaired = evaluate(problem, r_op, r_d)
-                if repaired < best_value - 1e-12:
-                    best_x, best_value = (r_op, r_d), repaired
+            candidates = [polish(small, nb, *mend(small, nb, operated, delay))]
+            if exact_repair:  # the rows' flights re-solved exactly around the point (lns.py)
+                fixed = lns.repair(problem, small, operated, delay, np.concatenate([cons.p[pair], cons.q[pair],
+                                   cons.te[turn], cons.tf[turn]]), min(deadline, time.perf_counter() + REPAIR_S),
+                                   threads, seed)
+                if fixed is not None:
+                    candidates.append(polish(small, nb, *fixed))
+            for r_op, r_d in candidates:
+                if not violations(problem, r_op, r_d):
+                    v = evaluate(problem, r_op, r_d)
+                    repaired = v if repaired is None else min(repaired, v)
+                    if v < best_value - 1e-12:
+                        best_x, best_value = (r_op, r_d), v
             chosen = np.flatnonzero(np.round(run.x) > 0.5)
             cell_hi = np.zeros(len(operated))
             cell_hi[np.searchsorted(st, chosen, side="right") - 1] = upper[chosen]
@@ -403,7 +424,7 @@ def discover(problem: SchedulingProblem, small: SchedulingProblem, deadline: flo
                 if ends:
                     added += cells.add(np.asarray(who, dtype=np.int64), np.asarray(ends))
         rounds.append(Round(model.n_cols, model.n_rows, run.bound, value, run.proved, len(pair) + len(turn), added,
-                            repaired, time.perf_counter() - t))
+                            repaired, time.perf_counter() - t, t_built - t, t_solved - t_built, run.termination))
         if log is not None:
             log(rounds[-1], bound, best_value)
         rel = (best_value - bound) / max(1e-9, abs(best_value)) if bound is not None and math.isfinite(best_value) else 1.0
@@ -415,6 +436,7 @@ def discover(problem: SchedulingProblem, small: SchedulingProblem, deadline: flo
             round_gap = 0.0
             continue
         round_gap = min(gap, 0.25 * rel)  # coarse rounds while far, exact ones when close
+    state["bound"] = bound
     return Discovery(bound=bound, operated=None if best_x is None else best_x[0],
                      delay_s=None if best_x is None else best_x[1], objective=best_value,
                      proved=bound is not None and best_value - bound <= 1e-9 * (1 + abs(best_value)),
@@ -440,22 +462,41 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
     start = warm_start(problem, o("step_s"), seed=profile.seed)
     small = reduced(problem)
     lns_s = o("lns_share") * limit
+    state: dict = {}
     found = discover(problem, small, t0 + limit - lns_s, profile.threads, profile.seed, step_s=o("step_s"),
-                     start=start.decisions if start.found else None, gap=o("mip_rel_gap"), cliques=o("cliques"))
-    operated, delay, value = found.operated, found.delay_s, found.objective
+                     start=start.decisions if start.found else None, gap=o("mip_rel_gap"), cliques=o("cliques"),
+                     round_s=o("round_time_limit_s"), state=state)
+    rounds = list(found.rounds)
+    operated, delay = found.operated, found.delay_s
     if operated is None or delay is None:
         raise no_schedule(problem, profile.name or "discovery", "no round gave a schedule within the limit")
     windows = passes = 0
+    try:
+        problem.requires  # noqa: B018 (lns.py frees returns with their outbounds: one required flight each)
+        searchable = True
+    except AttributeError:  # precedence groups of several flights (speed options): no neighbourhood search
+        searchable = False
     while not found.proved and t0 + limit - time.perf_counter() >= LNS_MIN_S:
-        operated, delay, better = lns.improve(problem, small, operated, delay, t0 + limit, profile.threads,
-                                              profile.seed, size=o("lns_window"))
-        windows += better
-        passes += 1
-        if not better:
+        better = 0
+        if searchable:
+            operated, delay, better = lns.improve(problem, small, operated, delay, t0 + limit, profile.threads,
+                                                  profile.seed, size=o("lns_window"))
+            windows += better
+            passes += 1
+        if better:
+            continue
+        # the search is stuck: the time left goes back to discovery, from its cells and schedule
+        found = discover(problem, small, t0 + limit, profile.threads, profile.seed, step_s=o("step_s"),
+                         start=(operated, delay), gap=o("mip_rel_gap"), cliques=o("cliques"),
+                         round_s=o("round_time_limit_s"), state=state)
+        rounds += found.rounds
+        if found.operated is not None and found.delay_s is not None and \
+                evaluate(problem, found.operated, found.delay_s) < evaluate(problem, operated, delay):
+            operated, delay = found.operated, found.delay_s
+        if not found.rounds:
             break
     value = evaluate(problem, operated, delay)
     proved = found.bound is not None and value - found.bound <= 1e-9 * (1.0 + abs(value))
-    rounds = found.rounds
     extras = {"model": "continuous (bound: " + found.model + ")", "model_kind": "continuous",
               "rounds": len(rounds), "cuts": int(sum(r.cuts for r in rounds)),
               "columns": rounds[-1].columns if rounds else 0, "rows": rounds[-1].rows if rounds else 0,

@@ -44,14 +44,71 @@ def _neighbourhood(problem: SchedulingProblem, free: np.ndarray, operated: np.nd
     return np.flatnonzero(is_free), np.flatnonzero(fixed)
 
 
-def improve(problem: SchedulingProblem, small: SchedulingProblem, operated: np.ndarray, delay_s: np.ndarray,
-            deadline: float, threads: int, seed: int, size: int = WINDOW, log=None) -> tuple[np.ndarray, np.ndarray, int]:
-    """One pass of windows over the day (module docstring) until ``deadline``; returns the decisions and
-    how many windows improved them."""
+def _solve_free(problem: SchedulingProblem, small: SchedulingProblem, operated: np.ndarray, delay: np.ndarray,
+                free: np.ndarray, deadline: float, threads: int, seed: int):
+    """The window ``free`` solved exactly with the operated flights around it fixed (module docstring):
+    (global indices of the free flights, their operated flags, delays, proved) or None."""
     from uamopt.solvers.discovery import discover
     from uamopt.solvers.rolling import subproblem
     from uamopt.solvers.warmstart import reduced
 
+    free, fixed = _neighbourhood(small, free, operated)
+    if not len(free):
+        return None
+    sub, index, is_fixed = subproblem(small, free, fixed, small.planned_departure_s + delay)
+    start = (operated[index].copy(), np.where(is_fixed, 0.0, delay[index]))
+    found = discover(sub, reduced(sub), deadline, threads, seed, start=start, cliques=False, exact_repair=False)
+    if found.operated is None or found.delay_s is None or not np.all(found.operated[is_fixed]):
+        return None
+    keep = ~is_fixed
+    return index[keep], found.operated[keep], np.where(found.operated[keep], found.delay_s[keep], 0.0), found.proved
+
+
+def repair(problem: SchedulingProblem, small: SchedulingProblem, operated: np.ndarray, delay_s: np.ndarray,
+           flights: np.ndarray, deadline: float, threads: int, seed: int) -> tuple[np.ndarray, np.ndarray] | None:
+    """A schedule from a point whose only broken rows are among ``flights``: those flights are freed,
+    every other operated flight is fixed where the point put it, and each group of freed flights that
+    share a row (a pair, a turnaround, an aircraft) is solved exactly on its own. None when a group
+    finds no schedule in time or the result breaks a row."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    operated, delay = operated.copy(), np.where(operated, delay_s, 0.0)
+    n = problem.n_flights
+    freed = np.zeros(n, dtype=bool)
+    freed[flights] = True
+    view = problem.pairs
+    aircraft = problem.flights.aircraft_index
+    t = problem.turnaround
+    a = np.concatenate([view.p, t.e])
+    b = np.concatenate([view.q, t.f])
+    link = freed[a] & freed[b]
+    graph = coo_matrix((np.ones(int(link.sum())), (a[link], b[link])), shape=(n, n))
+    _, label = connected_components(graph, directed=False)
+    label = np.where(freed, label, -1)
+    same: dict[int, list[int]] = {}  # flights of one aircraft in one group: their chain rows bind them together
+    for f in np.flatnonzero(freed).tolist():
+        same.setdefault(int(aircraft[f]), []).append(f)
+    for chain in same.values():
+        label[chain] = label[chain[0]]
+    operated[freed], delay[freed] = False, 0.0  # the groups' solves decide them
+    for group in np.unique(label[label >= 0]).tolist():
+        if time.perf_counter() > deadline:
+            return None
+        solved = _solve_free(problem, small, operated, delay, np.flatnonzero(label == group), deadline, threads, seed)
+        if solved is None:
+            return None
+        index, op, d, _ = solved
+        operated[index], delay[index] = op, d
+    if violations(problem, operated, delay):
+        return None
+    return operated, delay
+
+
+def improve(problem: SchedulingProblem, small: SchedulingProblem, operated: np.ndarray, delay_s: np.ndarray,
+            deadline: float, threads: int, seed: int, size: int = WINDOW, log=None) -> tuple[np.ndarray, np.ndarray, int]:
+    """One pass of windows over the day (module docstring) until ``deadline``; returns the decisions and
+    how many windows improved them."""
     operated, delay = operated.copy(), np.where(operated, delay_s, 0.0)
     value = evaluate(problem, operated, delay)
     order = np.argsort(small.planned_departure_s, kind="stable")
@@ -59,22 +116,17 @@ def improve(problem: SchedulingProblem, small: SchedulingProblem, operated: np.n
     for lo in range(0, max(1, len(order) - size // 2), max(1, size // 2)):
         if time.perf_counter() > deadline - 0.5:
             break
-        free, fixed = _neighbourhood(small, order[lo:lo + size], operated)
-        if not len(free):
+        solved = _solve_free(problem, small, operated, delay, order[lo:lo + size],
+                             min(deadline, time.perf_counter() + WINDOW_S), threads, seed)
+        if solved is None:
             continue
-        sub, index, is_fixed = subproblem(small, free, fixed, small.planned_departure_s + delay)
-        start = (operated[index].copy(), np.where(is_fixed, 0.0, delay[index]))
-        found = discover(sub, reduced(sub), min(deadline, time.perf_counter() + WINDOW_S), threads, seed,
-                         start=start, cliques=False)
-        if found.operated is None or found.delay_s is None or not np.all(found.operated[is_fixed]):
-            continue
+        index, op, d, proved = solved
         new_op, new_d = operated.copy(), delay.copy()
-        new_op[index[~is_fixed]] = found.operated[~is_fixed]
-        new_d[index[~is_fixed]] = np.where(found.operated[~is_fixed], found.delay_s[~is_fixed], 0.0)
+        new_op[index], new_d[index] = op, d
         new_value = evaluate(problem, new_op, new_d)
         if new_value < value - 1e-9 and not violations(problem, new_op, new_d):
             operated, delay, value = new_op, new_d, new_value
             better += 1
         if log is not None:
-            log(lo, len(free), len(fixed), found.proved, value)
+            log(lo, len(index), proved, value)
     return operated, delay, better

@@ -1,0 +1,183 @@
+"""Solver ``discovery`` (uamopt/solvers/discovery.py, polish.py, lns.py), checked outside its code:
+
+- every cell pair the relaxation forbids holds only forbidden delay pairs: operating just those two
+  flights anywhere in the two cells (ends and inner points tried) breaks a pair interval or a
+  turnaround as tests/oracles.py's ``broken`` reads them (no uamopt code), on cells cut at random;
+- on tiny instances its bound never exceeds the enumerated continuous optimum (tests/oracles.py),
+  its schedule passes the oracle, and when it says ``optimal`` its objective is that optimum;
+- mended points, polished schedules and neighbourhood search results pass the oracle; the search
+  improves a greedy schedule of a dense instance;
+- on the paper case it proves the optimum that the continuous MILP (``highs``) proves;
+- at a 10 s limit it is never worse than the preliminary strategy (``greedy``, exact gaps).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from oracles import broken, exact_optimum, model_data, score
+from strategies import tiny_problems
+
+from uamopt.schedule import build_problem, generate_plan
+from uamopt.solvers import SolverProfile, solve
+from uamopt.solvers.discovery import Cells, Constraints, build, cut, point
+from uamopt.solvers.lns import improve
+from uamopt.solvers.polish import Neighbours, mend, polish
+from uamopt.solvers.warmstart import reduced, warm_start
+
+OBJ_TOL = 1e-6
+
+
+def _pair_broken(data: dict, f: int, g: int, d_f: float, d_g: float) -> bool:
+    """Operating only f and g (delays d_f, d_g) breaks a conflict interval or a turnaround (the oracle)."""
+    n = len(data["planned_s"])
+    operated, delay = np.zeros(n, bool), np.zeros(n)
+    operated[[f, g]] = True
+    delay[f], delay[g] = d_f, d_g
+    lines = broken(dict(data, requires=[-1] * n, must=[False] * n, upper_s=[1e9] * n), operated, delay, tol_s=0.0)
+    return any("turnaround" in line or "δ" in line for line in lines)
+
+
+def _inside(lo: float, hi: float, last: bool) -> list[float]:
+    """Delays of the cell [lo, hi) ([lo, hi] when it is its flight's last): its ends and inner points."""
+    top = hi if last else hi - 1e-7 * max(1.0, hi - lo)
+    return sorted({lo, lo + 0.37 * (top - lo), max(lo, top)})
+
+
+@pytest.fixture(scope="module")
+def dense_problem(paper_straight_plan):
+    """The paper case's straight tracks, 160 flights of 20 eVTOLs in the hour (many share a cell at once)."""
+    scenario, _, network, _ = paper_straight_plan
+    scenario = scenario.model_copy(update={"schedule": scenario.schedule.model_copy(update={"flights": 160})})
+    return build_problem(generate_plan(scenario, network, seed=3), scenario, objective="weighted")
+
+
+def test_every_forbidden_cell_pair_holds_only_forbidden_delays(dense_problem):
+    small = reduced(dense_problem)
+    cells = Cells.uniform(small, 10.0)
+    rng = np.random.default_rng(0)
+    for f in range(small.n_flights):  # random cuts, and cuts at exact gap ends (cells of zero width to 1e-9 apart)
+        u = float(cells.upper[f])
+        if u > 0:
+            cells.add(np.full(3, f), rng.uniform(0.0, u, 3))
+    cons = Constraints.of(small)
+    cells.add(cons.q, cons.hi)  # the cuts discovery makes: where z reaches an interval's end
+    cells.add(cons.p, -cons.lo)
+    model, lower, upper = build(small, cells, cons, None)
+    start = model.start
+    last = np.zeros(model.n_cols, dtype=bool)
+    last[start[1:] - 1] = True
+    flight = np.searchsorted(start, np.arange(model.n_cols), side="right") - 1
+    data = model_data(dense_problem)
+    checked = 0
+    for r in range(len(model.row_ptr) - 1):
+        cols = model.row_col[model.row_ptr[r]:model.row_ptr[r + 1]]
+        owners = flight[cols]
+        if len(set(owners.tolist())) < 2:
+            continue  # an assignment row
+        a = cols[0]  # x_{p,a} first, then q's cells
+        for b in cols[1:][rng.permutation(len(cols) - 1)[:3]]:
+            f, g = int(flight[a]), int(flight[b])
+            for d_f in _inside(lower[a], upper[a], last[a]):
+                for d_g in _inside(lower[b], upper[b], last[b]):
+                    assert _pair_broken(data, f, g, d_f, d_g), (r, f, g, d_f, d_g)
+            checked += 1
+    assert checked >= 500  # dense: the check is not vacuous
+
+
+def test_a_cut_forbids_the_point_that_broke_a_row(dense_problem):
+    """After :func:`cut`, the rebuilt relaxation refuses the point that broke rows (the round cannot repeat)."""
+    small = reduced(dense_problem)
+    cons = Constraints.of(small)
+    cells = Cells.uniform(small, 10.0)
+    model, lower, upper = build(small, cells, cons, None)
+    # every flight operated at the lower end of its first cell: planned departures, many conflicts
+    x = np.zeros(model.n_cols)
+    x[model.start[:-1]] = 1.0
+    operated, delay = point(x, model.start, lower)
+    assert len(cons.broken(operated, delay)[0]) > 0
+    was_feasible = _row_sums(model, x).max() <= 1
+    assert was_feasible  # the first cells do not see these conflicts: the relaxation cheats here
+    assert cut(cells, cons, operated, delay, upper[model.start[:-1]]) > 0
+    model, lower, _ = build(small, cells, cons, None)
+    x = cells.cell_of(delay, operated, model.start)
+    assert _row_sums(model, x).max() > 1
+
+
+def _row_sums(model, x: np.ndarray) -> np.ndarray:
+    rows = np.repeat(np.arange(len(model.row_ptr) - 1), np.diff(model.row_ptr))
+    return np.bincount(rows, weights=x[model.row_col], minlength=len(model.row_ptr) - 1)
+
+
+@settings(max_examples=40, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
+@given(tiny_problems(max_flights=5))
+def test_tiny_instances_bound_below_the_enumerated_optimum(case):
+    _, problem = case
+    data = model_data(problem)
+    best, _, _ = exact_optimum(data)
+    result = solve(problem, SolverProfile("discovery", time_limit_s=20.0, threads=1))
+    assert broken(data, result.operated, result.delay_s) == []
+    assert result.bound is not None and result.bound <= best + OBJ_TOL
+    if result.status == "optimal":
+        assert score(data, result.operated, result.delay_s) == pytest.approx(best, abs=OBJ_TOL)
+    _PROVED.append(result.status == "optimal")
+
+
+_PROVED: list[bool] = []
+
+
+def test_tiny_instances_are_mostly_proved():
+    """The property test above is not vacuous: discovery proves most tiny instances optimal."""
+    if not _PROVED:
+        test_tiny_instances_bound_below_the_enumerated_optimum()
+    assert sum(_PROVED) >= 0.9 * len(_PROVED), _PROVED
+
+
+def test_mend_and_polish_give_schedules(dense_problem):
+    small = reduced(dense_problem)
+    data = model_data(dense_problem)
+    nb = Neighbours(small)
+    rng = np.random.default_rng(1)
+    for trial in range(5):  # random points: most flights operated at random delays, many rows broken
+        operated = rng.random(small.n_flights) < 0.9
+        delay = np.where(operated, rng.uniform(0, 1, small.n_flights) * small.delay_upper_s, 0.0)
+        assert broken(data, operated, delay) != []
+        op, d = mend(small, nb, operated, delay)
+        assert broken(data, op, d) == [], trial
+        op2, d2 = polish(small, nb, op, d)
+        assert broken(data, op2, d2) == [], trial
+        assert np.all(d2[op & op2] <= d[op & op2] + 1e-9)  # left shifts only
+
+
+def test_neighbourhood_search_improves_a_greedy_schedule(dense_problem):
+    import time
+
+    small = reduced(dense_problem)
+    data = model_data(dense_problem)
+    start = warm_start(dense_problem, 10.0)
+    before = score(data, *start.decisions)
+    op, d, better = improve(dense_problem, small, *start.decisions, time.perf_counter() + 60.0, 1, 0, size=40)
+    assert broken(data, op, d) == []
+    assert better > 0 and score(data, op, d) < before - 1e-6
+
+
+@pytest.mark.parametrize("objective", ["weighted", "lexicographic"])
+def test_paper_case_proved_optimal_as_the_continuous_milp(paper_straight_plan, objective):
+    scenario, _, _, flights = paper_straight_plan
+    problem = build_problem(flights, scenario, objective=objective)
+    found = solve(problem, SolverProfile("discovery", time_limit_s=60.0, threads=2))
+    milp = solve(problem, SolverProfile("highs", time_limit_s=120.0, threads=2))
+    assert found.status == "optimal" and milp.status == "optimal"
+    assert found.objective == pytest.approx(milp.objective, abs=OBJ_TOL)
+    assert found.bound == pytest.approx(milp.objective, abs=OBJ_TOL)
+    assert broken(model_data(problem), found.operated, found.delay_s) == []
+
+
+def test_never_worse_than_greedy_at_a_short_limit(dense_problem):
+    greedy = solve(dense_problem, SolverProfile("greedy", options={"exact_gaps": True}))
+    found = solve(dense_problem, SolverProfile("discovery", time_limit_s=10.0, threads=1))
+    data = model_data(dense_problem)
+    assert broken(data, found.operated, found.delay_s) == []
+    assert score(data, found.operated, found.delay_s) <= score(data, greedy.operated, greedy.delay_s) + OBJ_TOL
+    assert found.bound is not None and found.bound <= score(data, found.operated, found.delay_s) + OBJ_TOL

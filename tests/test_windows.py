@@ -1,0 +1,76 @@
+"""Solver ``windows`` (uamopt/solvers/windows.py): windows of flights as Dask tasks, a global bound.
+
+Checked against answers it does not compute itself:
+- its bound (the sum of the windows' bounds) never exceeds the optimum that the continuous MILP
+  (``highs``, a different model) proves for the whole day, and its schedule passes the oracle of
+  tests/oracles.py;
+- the same answer (decisions, objective, bound) on a 1-worker and a 2-worker LocalCluster and on a
+  separately started ``dask scheduler`` with two ``dask worker`` processes (conftest.py).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from oracles import broken, model_data, score
+
+from uamopt.schedule import build_problem
+from uamopt.solvers import SolverProfile, solve
+from uamopt.solvers.windows import split, window_problem
+
+pytest.importorskip("distributed", reason="the windows solver runs on Dask: the [sweep] extra")
+
+OBJ_TOL = 1e-6
+
+
+@pytest.fixture(scope="module")
+def day(paper_straight_plan):
+    """The paper case's 120 flights (weighted objective) and its optimum proved by the continuous MILP."""
+    scenario, _, _, flights = paper_straight_plan
+    problem = build_problem(flights, scenario, objective="weighted")
+    best = solve(problem, SolverProfile("highs", time_limit_s=120.0, threads=2))
+    assert best.status == "optimal"
+    return problem, best.objective
+
+
+def _run(problem, **options):
+    options = {"window_flights": 40, "rounds": 40, "window_time_limit_s": 60.0, **options}
+    return solve(problem, SolverProfile("windows", time_limit_s=90.0, threads=1, options=options))
+
+
+def test_window_problems_keep_only_their_own_rows(day):
+    problem, _ = day
+    windows = split(problem, 40)
+    assert sorted(np.concatenate(windows).tolist()) == list(range(problem.n_flights))
+    pairs = {(int(p), int(q)) for p, q in zip(problem.conflicts.p, problem.conflicts.q, strict=True)}
+    kept = 0
+    for index in windows:
+        sub = window_problem(problem, index)
+        assert sub.n_flights == len(index)
+        mapped = {(int(index[p]), int(index[q])) for p, q in zip(sub.conflicts.p, sub.conflicts.q, strict=True)}
+        inside = {(p, q) for p, q in pairs if p in set(index.tolist()) and q in set(index.tolist())}
+        assert mapped == inside
+        kept += len(mapped)
+    assert 0 < kept < len(pairs)  # some rows cross windows and are dropped
+
+
+def test_bound_below_the_proved_optimum_and_schedule_feasible(day):
+    problem, best = day
+    result = _run(problem, workers=2)
+    data = model_data(problem)
+    assert broken(data, result.operated, result.delay_s) == []
+    assert result.bound is not None and result.bound <= best + OBJ_TOL
+    assert score(data, result.operated, result.delay_s) >= best - OBJ_TOL
+    assert result.extras["windows"] == 3 and result.extras["windows_at_limit"] == 0
+    # the dropped rows cost little here: the bound is within 5 % of the optimum (regression value: 2.9 %)
+    assert best - result.bound <= 0.05 * abs(best)
+
+
+def test_same_answer_on_one_or_two_workers_and_on_a_started_cluster(day, cluster):
+    problem, _ = day
+    runs = [_run(problem, workers=1), _run(problem, workers=2), _run(problem, scheduler=cluster)]
+    assert runs[2].extras["scheduler"] == cluster
+    for other in runs[1:]:
+        assert other.objective == runs[0].objective and other.bound == runs[0].bound
+        assert np.array_equal(other.operated, runs[0].operated) and np.allclose(other.delay_s, runs[0].delay_s)
+        assert other.extras["windows_at_limit"] == 0
