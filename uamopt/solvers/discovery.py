@@ -57,8 +57,8 @@ A round's MILP stops at the relative gap ``mip_rel_gap`` while the best schedule
 bound, at a quarter of that distance once closer, or after ``round_s`` seconds (its bound is then
 HiGHS's dual bound, still valid, and its incumbent gives the cuts), and at 0 with no time cap when
 its point was a schedule (to prove it). Dynamic discretisation discovery is due to Boland, Hewitt,
-Savelsbergh ("The continuous-time service network design problem", Operations Research 65(5), 2017); the cells here are delays, and
-the cuts are the forbidden intervals' ends.
+Savelsbergh ("The continuous-time service network design problem", Operations Research 65(5),
+2017); the cells here are delays, and the cuts are the forbidden intervals' ends.
 
 Applies to problems without the ``cumulative`` shape (pads) and with a delay cost non-decreasing
 in the delay (not earliness/tardiness): :data:`SHAPES`, :data:`OBJECTIVES`.

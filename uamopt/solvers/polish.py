@@ -138,6 +138,9 @@ def mend(problem: SchedulingProblem, nb: Neighbours, operated: np.ndarray, delay
     dep = problem.planned_departure_s + delay
     cons = Constraints.of(problem)
     out: list[int] = []
+    for f in np.flatnonzero(operated).tolist():  # a flight operated without its required one
+        if operated[f] and not nb.allowed(f, operated):
+            out += nb.drop(f, operated, delay)
     for _ in range(problem.n_flights + 1):
         pair, turn = cons.broken(operated, delay)
         if not len(pair) and not len(turn):
