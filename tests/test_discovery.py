@@ -26,7 +26,7 @@ from uamopt.solvers import SolverProfile, solve
 from uamopt.solvers.discovery import Cells, Constraints, build, cut, point
 from uamopt.solvers.lns import improve
 from uamopt.solvers.polish import Neighbours, mend, polish
-from uamopt.solvers.timeindexed import _highs
+from uamopt.solvers.timeindexed import run_highs
 from uamopt.solvers.warmstart import reduced, warm_start
 
 OBJ_TOL = 1e-6
@@ -95,7 +95,7 @@ def test_a_cut_forbids_the_point_that_broke_a_row(dense_problem):
     cons = Constraints.of(small)
     cells = Cells.uniform(small, 10.0)
     model, lower, upper = build(small, cells, cons, None)
-    run = _highs(model, time.perf_counter() + 60.0, 1, 0, 0.0, None)  # the relaxation's optimum
+    run = run_highs(model, time.perf_counter() + 60.0, 1, 0, 0.0, None)  # the relaxation's optimum
     x = np.round(run.x)
     operated, delay = point(x, model.start, lower)
     pair, turn = cons.broken(operated, delay)

@@ -18,7 +18,7 @@ STAGES = ["base", "grid", "city", "risk", "planning", "schedule", "solvers"]
 COMMANDS = ["io", "pipeline", "export", "plotting", "sim", "experiments", "workflows", "report", "reproduce", "cli"]
 ORDER = STAGES + COMMANDS
 LAYER_OF = {"errors": "base", "bounds": "base", "checks": "base", "scenario": "base", "outputs": "base", "interrupts": "base",
-            "lazy": "base", "optional": "base", "shipped": "base", "progress": "base", "paper": "base",
+            "lazy": "base", "cluster": "base", "optional": "base", "shipped": "base", "progress": "base", "paper": "base",
             "__version__": "base",  # the facade's one attribute every layer may read (package metadata)
             "grid": "grid", "city": "city", "risk": "risk", "planning": "planning", "schedule": "schedule",
             "solvers": "solvers", "io": "io", "pipeline": "pipeline", "export": "export", "plotting": "plotting",

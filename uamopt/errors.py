@@ -56,3 +56,10 @@ class NoSpaceError(UamoptError):
 
 class InfeasibleScheduleError(UamoptError):
     """No schedule satisfies the constraints."""
+
+
+def error_line(exc: BaseException) -> str:
+    """An exception as one short line: ``Type: message`` (a UamoptError's own line)."""
+    text = exc.line() if isinstance(exc, UamoptError) else str(exc)
+    first = (text.strip().splitlines() or [""])[0]
+    return f"{type(exc).__name__}: {first}"[:400]

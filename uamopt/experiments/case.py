@@ -26,14 +26,7 @@ import time
 
 import numpy as np
 
-
-def error_line(exc: BaseException) -> str:
-    """An exception as one short line: ``Type: message`` (a UamoptError's own line)."""
-    from uamopt.errors import UamoptError
-
-    text = exc.line() if isinstance(exc, UamoptError) else str(exc)
-    first = (text.strip().splitlines() or [""])[0]
-    return f"{type(exc).__name__}: {first}"[:400]
+from uamopt.errors import error_line
 
 
 def _unless_out_of_space(exc: Exception) -> None:

@@ -350,7 +350,7 @@ def discover(problem: SchedulingProblem, small: SchedulingProblem, deadline: flo
     within ``target_gap`` (relative) of the bound. Schedules are evaluated on ``problem``."""
     from uamopt.solvers import lns
     from uamopt.solvers.polish import Neighbours, mend, polish
-    from uamopt.solvers.timeindexed import _highs
+    from uamopt.solvers.timeindexed import run_highs
 
     cons = Constraints.of(small)
     nb = Neighbours(small)
@@ -378,7 +378,7 @@ def discover(problem: SchedulingProblem, small: SchedulingProblem, deadline: flo
         hint = cells.cell_of(best_x[1], best_x[0], st) if best_x is not None else None
         t_built = time.perf_counter()
         cap = deadline if round_gap == 0.0 or round_s is None else min(deadline, time.perf_counter() + round_s)
-        run = _highs(model, cap, threads, seed, round_gap, hint)
+        run = run_highs(model, cap, threads, seed, round_gap, hint)
         t_solved = time.perf_counter()
         if run.bound is not None:  # every round's relaxation bounds the continuous optimum
             bound = run.bound if bound is None else max(bound, run.bound)

@@ -356,9 +356,10 @@ def load_model(h, model: GridModel, integer: bool) -> None:
                   model.cap_col.astype(np.int32), np.ones(len(model.cap_col)))
 
 
-def _highs(model: GridModel, deadline: float, threads: int, seed: int, gap: float, hint: np.ndarray | None,
-           presolve: bool = True) -> EngineResult:
-
+def run_highs(model: GridModel, deadline: float, threads: int, seed: int, gap: float, hint: np.ndarray | None,
+              presolve: bool = True) -> EngineResult:
+    """HiGHS on a :class:`GridModel` until ``deadline`` (a ``time.perf_counter`` time), from the MIP
+    start ``hint`` when given (discovery.py runs its rounds through it too)."""
     # at 1,000 flights HiGHS's presolve took the whole limit; without it HiGHS finds incumbents fast
     h = mip_solver(threads, seed, gap, presolve)
     load_model(h, model, integer=True)
@@ -368,7 +369,7 @@ def _highs(model: GridModel, deadline: float, threads: int, seed: int, gap: floa
     x = run.x
     if hint is not None and x is not None and abs(float(model.cost @ x) - run.objective) > 1e-6 * (
             1.0 + abs(run.objective)):  # a solution that is not the one reported: trust neither
-        return _highs(model, deadline, threads, seed, gap, None, presolve)
+        return run_highs(model, deadline, threads, seed, gap, None, presolve)
     bound = run.bound
     if run.proved and x is not None:
         bound = min(bound, float(model.cost @ np.round(x))) if bound is not None else float(model.cost @ np.round(x))
@@ -448,13 +449,13 @@ def run_engine(engine: str, model: GridModel, problem: SchedulingProblem, limit_
         return EngineResult(x=None, bound=None, proved=False, seconds=0.0,
                             termination="not run (HiGHS could not start within the limit: solvers/highs.py)")
     if engine == "highs":
-        return _highs(model, deadline, threads, seed, gap, hint)
+        return run_highs(model, deadline, threads, seed, gap, hint)
     if engine == "cpsat":
         return _cpsat(model, problem, deadline, threads, seed, gap, hint)
     if engine == "hybrid" and not highs_can_start(model.n_rows, HYBRID_HIGHS_SHARE * limit_s, presolve=False):
         return _cpsat(model, problem, deadline, threads, seed, gap, hint)  # HiGHS could not even start in its share
     if engine == "hybrid":  # HiGHS without presolve for incumbents, then CP-SAT from its best for the bound
-        first = _highs(model, time.perf_counter() + HYBRID_HIGHS_SHARE * limit_s, threads, seed, gap, hint, presolve=False)
+        first = run_highs(model, time.perf_counter() + HYBRID_HIGHS_SHARE * limit_s, threads, seed, gap, hint, presolve=False)
         if first.proved:
             return first
         start = first.x if first.x is not None else hint

@@ -116,7 +116,7 @@ def join(problem: SchedulingProblem, parts: list[tuple[np.ndarray, dict]]) -> tu
 
 def solve(problem: SchedulingProblem, profile: SolverProfile) -> Schedule:
     """Windows on Dask, the sum of their bounds, the joined schedule (module docstring)."""
-    from uamopt.experiments.engine import connect
+    from uamopt.cluster import connect
     from uamopt.solvers import lns
     from uamopt.solvers.warmstart import no_worse, reduced, warm_start
 
