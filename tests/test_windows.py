@@ -74,3 +74,30 @@ def test_same_answer_on_one_or_two_workers_and_on_a_started_cluster(day, cluster
         assert other.objective == runs[0].objective and other.bound == runs[0].bound
         assert np.array_equal(other.operated, runs[0].operated) and np.allclose(other.delay_s, runs[0].delay_s)
         assert other.extras["windows_at_limit"] == 0
+
+
+def test_the_scheduler_flag_runs_the_windows_on_a_started_cluster(tmp_path, cluster):
+    """``uamopt schedule --solver windows --scheduler ADDRESS``: the tasks on the started cluster, a
+    verified folder; the flag with another solver is one line, exit code 2, and writes nothing."""
+    import subprocess
+    import sys
+
+    profile = tmp_path / "w.toml"
+    profile.write_text('solver = "windows"\ntime_limit_s = 60.0\nthreads = 1\n[options]\nwindow_flights = 40\n'
+                       'rounds = 40\nwindow_time_limit_s = 30.0\n', encoding="utf-8")
+
+    def run(*args):
+        return subprocess.run([sys.executable, "-m", "uamopt", "schedule", "models/paper_case.toml", "--set",
+                               'schedule.objective="weighted"', *args], capture_output=True, text=True, timeout=300)
+
+    out = tmp_path / "out"
+    done = run("--solver", str(profile), "--scheduler", cluster, "--out", str(out))
+    assert done.returncode == 0, done.stderr
+    import json
+
+    summary = json.loads((out / "summary.json").read_text(encoding="utf-8"))
+    assert summary["extras"]["scheduler"] == cluster and summary["extras"]["windows"] == 3
+    refused = run("--solver", "greedy", "--scheduler", cluster, "--out", str(tmp_path / "nothing"))
+    lines = refused.stderr.strip().splitlines()
+    assert refused.returncode == 2 and len(lines) == 1 and "--scheduler is for the windows solver" in lines[0]
+    assert not (tmp_path / "nothing").exists()
