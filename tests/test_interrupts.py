@@ -7,6 +7,7 @@ Each case runs in a fresh interpreter (real signals to itself; the test process 
 from __future__ import annotations
 
 import os
+import signal
 import subprocess
 import sys
 from pathlib import Path
@@ -16,9 +17,18 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 
 
+def _as_from_a_terminal() -> None:
+    """The child starts with Ctrl-C at its default disposition, as a command typed in a terminal. An
+    ignored SIGINT is inherited across exec: twice in full ``make test`` runs (stop 32) a pytest
+    worker had SIGINT ignored when these scripts ran, and their interrupts never arrived; which
+    earlier test leaves it so is not found yet (alone, or after test_windows, test_sweep or
+    test_discovery in one worker, these tests pass)."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def run(script: str, timeout: float = 120.0) -> subprocess.CompletedProcess:
     return subprocess.run([sys.executable, "-c", script], cwd=ROOT, capture_output=True, text=True, check=False,
-                          timeout=timeout)
+                          timeout=timeout, preexec_fn=_as_from_a_terminal)
 
 
 CALLBACK = """import ctypes, sys, time
