@@ -250,3 +250,13 @@ def grid_shortest_length(passable, cell, source, target) -> float:
                 dist[nxt] = d + step
                 heapq.heappush(heap, (d + step, nxt))
     return math.inf
+
+
+def pair_broken(data: dict, f: int, g: int, d_f: float, d_g: float, tol_s: float = 1e-6) -> bool:
+    """Operating only f and g (delays d_f, d_g) breaks a conflict interval or a turnaround."""
+    n = len(data["planned_s"])
+    operated, delay = [False] * n, [0.0] * n
+    operated[f] = operated[g] = True
+    delay[f], delay[g] = d_f, d_g
+    lines = broken(dict(data, requires=[-1] * n, must=[False] * n, upper_s=[1e9] * n), operated, delay, tol_s)
+    return any("turnaround" in line or "δ" in line for line in lines)

@@ -246,3 +246,13 @@ def dominated(row_ptr: np.ndarray, row_col: np.ndarray, clique_ptr: np.ndarray, 
     out = np.zeros(n_rows, dtype=bool)
     out[row[shared == np.diff(row_ptr)[row]]] = True
     return out
+
+
+def drop_dominated(pair_ptr: np.ndarray, col: np.ndarray, clique_ptr: np.ndarray, clique_col: np.ndarray,
+                   n_cols: int) -> tuple[np.ndarray, np.ndarray, int]:
+    """The pair rows (CSR ``pair_ptr``, ``col``) less those a clique row implies (:func:`dominated`):
+    (pair_ptr, col, how many were dropped)."""
+    drop = dominated(pair_ptr, col, clique_ptr, clique_col, n_cols)
+    sizes = np.diff(pair_ptr)[~drop]
+    col = col[~np.repeat(drop, np.diff(pair_ptr))]
+    return np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64), col, int(drop.sum())

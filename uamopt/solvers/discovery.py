@@ -256,13 +256,9 @@ def build(problem: SchedulingProblem, cells: Cells, cons: Constraints, lifted: L
         row_size = np.add.reduceat(size, lifted.ptr[:-1]) if len(lifted.ptr) > 1 else np.zeros(0, np.int64)
         clique_ptr = np.concatenate([[0], np.cumsum(row_size)]).astype(np.int64)
         if drop_dominated:
-            from uamopt.solvers.cliques import dominated
+            from uamopt.solvers.cliques import drop_dominated as without_dominated
 
-            drop = dominated(pair_ptr, col, clique_ptr, clique_col, N)
-            n_dominated = int(drop.sum())
-            sizes = np.diff(pair_ptr)[~drop]
-            col = col[~np.repeat(drop, np.diff(pair_ptr))]
-            pair_ptr = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
+            pair_ptr, col, n_dominated = without_dominated(pair_ptr, col, clique_ptr, clique_col, N)
     row_ptr = np.concatenate([assign_ptr, assign_ptr[-1] + pair_ptr[1:], assign_ptr[-1] + pair_ptr[-1] + clique_ptr[1:]])
     row_col = np.concatenate([assign_cols, col, clique_col]).astype(np.int64)
     o = problem.objective

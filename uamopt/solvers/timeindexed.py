@@ -275,16 +275,12 @@ def build_grid_model(problem: SchedulingProblem, step_s: float = 10.0, kind: str
     row_col = np.concatenate([assign_cols, col]).astype(np.int64)
     n_cliques = n_dominated = 0
     if cliques:  # clique rows from the occupancy (cliques.py); the pair rows they imply dropped
-        from uamopt.solvers.cliques import dominated, occupancy_cliques
+        from uamopt.solvers.cliques import drop_dominated, occupancy_cliques
 
         clique_ptr, clique_col = occupancy_cliques(problem, start, step_s, kind)
         n_cliques = len(clique_ptr) - 1
         if n_cliques:
-            drop = dominated(pair_ptr, col, clique_ptr, clique_col, int(start[-1]))
-            n_dominated = int(drop.sum())
-            sizes = np.diff(pair_ptr)[~drop]
-            col = col[~np.repeat(drop, np.diff(pair_ptr))]
-            pair_ptr = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
+            pair_ptr, col, n_dominated = drop_dominated(pair_ptr, col, clique_ptr, clique_col, int(start[-1]))
             row_ptr = np.concatenate([assign_ptr, assign_ptr[-1] + pair_ptr[1:], assign_ptr[-1] + pair_ptr[-1] + clique_ptr[1:]])
             row_col = np.concatenate([assign_cols, col, clique_col]).astype(np.int64)
     prec = [(f, group) for family in problem.of_shape("precedence") for f, group in family.groups()]
