@@ -10,7 +10,7 @@ return whose outbound lies in another window is free to operate). Each is solved
 ``LocalCluster`` of ``workers`` processes by default, or on the running cluster at ``scheduler``
 (``tcp://host:8786``: ``dask scheduler`` and ``dask worker`` processes with uamopt installed).
 
-Global bound. The weighted objective W = ω6/G · Σ c d − ω7 · Σ c is a sum over flights, and every
+Global bound. The weighted objective (Eq. 20 with Eq. 21: W = ω6/G · Σ c d − ω7 · Σ c) is a sum over flights, and every
 row kept lies inside one window, so the problem with the cross-window rows dropped separates into
 the windows' relaxed sub-problems: its optimum is the *sum of their optima*, and it is a
 relaxation of the whole problem (fewer rows), so Σ_w bound_w ≤ Σ_w OPT_w ≤ OPT. The bound reported
