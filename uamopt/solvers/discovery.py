@@ -365,6 +365,7 @@ def discover(problem: SchedulingProblem, small: SchedulingProblem, deadline: flo
         if log is not None:
             log(None, None, best_value)
     bound: float | None = state.get("bound")
+    round_s = state.get("round_s", round_s)  # as an earlier call left it (doubled where rounds needed it)
     rounds: list[Round] = []
     round_gap = gap
     while time.perf_counter() < deadline - 0.5 and (max_rounds is None or len(rounds) < max_rounds):
@@ -376,12 +377,22 @@ def discover(problem: SchedulingProblem, small: SchedulingProblem, deadline: flo
         cap = deadline if round_gap == 0.0 or round_s is None else min(deadline, time.perf_counter() + round_s)
         run = run_highs(model, cap, threads, seed, round_gap, hint)
         t_solved = time.perf_counter()
+        capped = round_s is not None and cap < deadline and run.termination != "Optimal"
+        if capped and round_s is not None and bound is not None and (
+                run.bound is None or run.bound < bound - max(gap, 1e-3) * abs(bound)):
+            round_s *= 2.0  # the cap stopped HiGHS before its root's cuts: later rounds get twice as long
         if run.bound is not None:  # every round's relaxation bounds the continuous optimum
             bound = run.bound if bound is None else max(bound, run.bound)
-        if run.x is None:
+        if run.x is None:  # no point within the round's cap: the next round gets twice as long
             rounds.append(Round(model.n_cols, model.n_rows, run.bound, None, run.proved, 0, 0, None,
-                                time.perf_counter() - t))
-            break
+                                time.perf_counter() - t, t_built - t, t_solved - t_built, run.termination))
+            if log is not None:
+                log(rounds[-1], bound, best_value)
+            if round_s is None or cap >= deadline:
+                break
+            if not capped or bound is None:
+                round_s *= 2.0
+            continue
         operated, delay = point(run.x, st, lower)
         value = float(model.cost @ np.round(run.x))
         pair, turn = cons.broken(operated, delay)
@@ -433,6 +444,7 @@ def discover(problem: SchedulingProblem, small: SchedulingProblem, deadline: flo
             continue
         round_gap = min(gap, 0.25 * rel)  # coarse rounds while far, exact ones when close
     state["bound"] = bound
+    state["round_s"] = round_s
     return Discovery(bound=bound, operated=None if best_x is None else best_x[0],
                      delay_s=None if best_x is None else best_x[1], objective=best_value,
                      proved=bound is not None and best_value - bound <= 1e-9 * (1 + abs(best_value)),
@@ -476,7 +488,8 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
         better = 0
         if searchable:
             operated, delay, better = lns.improve(problem, small, operated, delay, t0 + limit, profile.threads,
-                                                  profile.seed, size=o("lns_window"))
+                                                  profile.seed, size=o("lns_window"),
+                                                  window_s=o("lns_window_time_limit_s"))
             windows += better
             passes += 1
         if better:

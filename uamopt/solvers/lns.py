@@ -20,8 +20,8 @@ import numpy as np
 
 from uamopt.schedule.model import SchedulingProblem, evaluate, violations
 
-WINDOW = 80  # flights per neighbourhood
-WINDOW_S = 3.0  # at most this many seconds per window's solve
+WINDOW = 250  # flights per neighbourhood
+WINDOW_S = 20.0  # at most this many seconds per window's solve
 
 
 def _neighbourhood(problem: SchedulingProblem, free: np.ndarray, operated: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -106,7 +106,8 @@ def repair(problem: SchedulingProblem, small: SchedulingProblem, operated: np.nd
 
 
 def improve(problem: SchedulingProblem, small: SchedulingProblem, operated: np.ndarray, delay_s: np.ndarray,
-            deadline: float, threads: int, seed: int, size: int = WINDOW, log=None) -> tuple[np.ndarray, np.ndarray, int]:
+            deadline: float, threads: int, seed: int, size: int = WINDOW, window_s: float = WINDOW_S,
+            log=None) -> tuple[np.ndarray, np.ndarray, int]:
     """One pass of windows over the day (module docstring) until ``deadline``; returns the decisions and
     how many windows improved them."""
     operated, delay = operated.copy(), np.where(operated, delay_s, 0.0)
@@ -117,7 +118,7 @@ def improve(problem: SchedulingProblem, small: SchedulingProblem, operated: np.n
         if time.perf_counter() > deadline - 0.5:
             break
         solved = _solve_free(problem, small, operated, delay, order[lo:lo + size],
-                             min(deadline, time.perf_counter() + WINDOW_S), threads, seed)
+                             min(deadline, time.perf_counter() + window_s), threads, seed)
         if solved is None:
             continue
         index, op, d, proved = solved

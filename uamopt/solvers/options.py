@@ -85,16 +85,18 @@ OWN: dict[str, dict[str, Opt]] = {
                     "continuous_bound_step_s": POSITIVE_S, "mip_rel_gap": Opt(float, 0.0, valid=Range(0.0, 1e6)),
                     "cliques": Opt(bool, True), "refine_step_s": Opt(float, 0.0, valid=Range(0.0, MAX_TIME_S))},
     "discovery": {"step_s": Opt(float, 10.0, valid=STEP_S), "mip_rel_gap": Opt(float, 0.005, valid=Range(0.0, 1.0)),
-                  "cliques": Opt(bool, True), "lns_share": Opt(float, 0.15, valid=Range(0.0, 1.0)),
+                  "cliques": Opt(bool, True), "lns_share": Opt(float, 0.35, valid=Range(0.0, 1.0)),
                   "round_time_limit_s": Opt(float, 15.0, valid=TIME_LIMIT_S),
-                  "lns_window": Opt(int, 80, valid=Range(2, 10**6, integer=True))},
+                  "lns_window": Opt(int, 250, valid=Range(2, 10**6, integer=True)),
+                  "lns_window_time_limit_s": Opt(float, 20.0, valid=TIME_LIMIT_S)},
     "windows": {"step_s": Opt(float, 10.0, valid=STEP_S), "mip_rel_gap": Opt(float, 0.005, valid=Range(0.0, 1.0)),
                 "cliques": Opt(bool, True), "rounds": Opt(int, 60, valid=Range(1, 10**6, integer=True)),
                 "round_time_limit_s": Opt(float, 15.0, valid=TIME_LIMIT_S),
                 "window_flights": Opt(int, 1000, valid=Range(2, 10**7, integer=True)),
                 "window_time_limit_s": Opt(float, valid=TIME_LIMIT_S),
                 "workers": Opt(int, 2, valid=Range(1, 4096, integer=True)), "scheduler": Opt(str, ""),
-                "lns_window": Opt(int, 80, valid=Range(2, 10**6, integer=True))},
+                "lns_window": Opt(int, 250, valid=Range(2, 10**6, integer=True)),
+                "lns_window_time_limit_s": Opt(float, 20.0, valid=TIME_LIMIT_S)},
 }
 #: solvers that hand every other option to the underlying library, after checking it there
 PASS_THROUGH = {"highs": "HiGHS", "cpsat": "CP-SAT"}

@@ -147,7 +147,8 @@ def solve(problem: SchedulingProblem, profile: SolverProfile) -> Schedule:
     passes = 0
     while time.perf_counter() - t0 < profile.time_limit_s - 2.0:
         operated, delay, better = lns.improve(problem, small, operated, delay, t0 + profile.time_limit_s,
-                                              profile.threads, profile.seed, size=o("lns_window"))
+                                              profile.threads, profile.seed, size=o("lns_window"),
+                                              window_s=o("lns_window_time_limit_s"))
         passes += 1
         if not better:
             break
