@@ -8,7 +8,11 @@
 - mended points, polished schedules and neighbourhood search results pass the oracle; the search
   improves a greedy schedule of a dense instance;
 - on the paper case it proves the optimum that the continuous MILP (``highs``) proves;
-- at a 10 s limit it is never worse than the preliminary strategy (``greedy``, exact gaps).
+- at a 10 s limit it is never worse than the preliminary strategy (``greedy``, exact gaps);
+- a round cut short by ``round_time_limit_s`` before HiGHS has a point or its root's bound does
+  not end discovery: later rounds get twice the time, and discovery still reaches the optimum;
+- ``lns_window_time_limit_s`` bounds each neighbourhood's solve: with no time per window the
+  search cannot improve the greedy schedule that it improves with time.
 """
 
 from __future__ import annotations
@@ -23,8 +27,8 @@ from strategies import tiny_problems
 
 from uamopt.schedule import build_problem, generate_plan
 from uamopt.solvers import SolverProfile, solve
-from uamopt.solvers.discovery import Cells, Constraints, build, cut, point
-from uamopt.solvers.lns import improve
+from uamopt.solvers.discovery import Cells, Constraints, build, cut, discover, point
+from uamopt.solvers.lns import improve, neighbourhoods
 from uamopt.solvers.polish import Neighbours, mend, polish
 from uamopt.solvers.timeindexed import run_highs
 from uamopt.solvers.warmstart import reduced, warm_start
@@ -152,6 +156,59 @@ def test_neighbourhood_search_improves_a_greedy_schedule(dense_problem):
     op, d, better = improve(dense_problem, small, *start.decisions, time.perf_counter() + 60.0, 1, 0, size=40)
     assert broken(data, op, d) == []
     assert better > 0 and score(data, op, d) < before - 1e-6
+
+
+def test_neighbourhoods_cover_the_day_and_whole_aircraft_days(dense_problem):
+    """A pass's time windows cover every flight; its aircraft groups are whole days of aircraft, each
+    aircraft in one group; the next pass shifts the windows and draws other groups; same seed, same pass."""
+    small = reduced(dense_problem)
+    aircraft = small.flights.aircraft_index
+    for pass_index in (0, 1):
+        hoods = neighbourhoods(small, 40, 0, pass_index)
+        windows = [f for label, f in hoods if label >= 0]
+        groups = [f for label, f in hoods if label < 0]
+        assert set(np.concatenate(windows).tolist()) == set(range(small.n_flights))
+        assert len(groups) > 1 and sorted(np.concatenate(groups).tolist()) == list(range(small.n_flights))
+        for g in groups:
+            assert set(np.flatnonzero(np.isin(aircraft, aircraft[g])).tolist()) == set(g.tolist())
+    first, second = neighbourhoods(small, 40, 0, 0), neighbourhoods(small, 40, 0, 1)
+    assert [f.tolist() for _, f in first if _ >= 0] != [f.tolist() for _, f in second if _ >= 0]
+    assert [f.tolist() for _, f in first if _ < 0] != [f.tolist() for _, f in second if _ < 0]
+    again = neighbourhoods(small, 40, 0, 1)
+    assert all(a == b and np.array_equal(f, g) for (a, f), (b, g) in zip(second, again, strict=True))
+
+
+def test_neighbourhood_windows_without_time_improve_nothing(dense_problem):
+    """The counterpart of the test above: the same search with no time per window (the option
+    ``lns_window_time_limit_s``) leaves the schedule as it was."""
+    small = reduced(dense_problem)
+    start = warm_start(dense_problem, 10.0)
+    op, d, better = improve(dense_problem, small, *start.decisions, time.perf_counter() + 60.0, 1, 0, size=40,
+                            window_s=0.0)
+    assert better == 0
+    assert np.array_equal(op, start.decisions[0]) and np.allclose(d, np.where(op, start.decisions[1], 0.0))
+
+
+@pytest.fixture(scope="module")
+def busy_problem(paper_straight_plan):
+    """The paper case's straight tracks, 480 flights of 80 eVTOLs: a relaxation HiGHS does not solve in 50 ms."""
+    scenario, _, network, _ = paper_straight_plan
+    scenario = scenario.model_copy(update={"schedule": scenario.schedule.model_copy(update={"flights": 480, "aircraft": 80})})
+    return build_problem(generate_plan(scenario, network, seed=3), scenario, objective="weighted")
+
+
+def test_a_round_cut_short_doubles_the_cap_and_discovery_goes_on(busy_problem):
+    small = reduced(busy_problem)
+    data = model_data(busy_problem)
+    state: dict = {}
+    found = discover(busy_problem, small, time.perf_counter() + 15.0, 1, 0, start=None, gap=0.005,
+                     round_s=1e-6, state=state)
+    assert found.rounds[0].termination != "Optimal"  # cut short at once (HiGHS's shortest limit, 50 ms)
+    assert state["round_s"] > 1e-6  # later rounds got longer ...
+    later = [r for r in found.rounds[1:] if r.value is not None]
+    assert later  # ... and discovery went on, from their points
+    assert found.operated is not None and broken(data, found.operated, found.delay_s) == []
+    assert found.bound is not None and found.bound <= score(data, found.operated, found.delay_s) + OBJ_TOL
 
 
 @pytest.mark.parametrize("objective", ["weighted", "lexicographic"])

@@ -101,3 +101,36 @@ def test_the_scheduler_flag_runs_the_windows_on_a_started_cluster(tmp_path, clus
     lines = refused.stderr.strip().splitlines()
     assert refused.returncode == 2 and len(lines) == 1 and "--scheduler is for the windows solver" in lines[0]
     assert not (tmp_path / "nothing").exists()
+
+
+def test_bench_scheduler_flag_runs_the_windows_profile_on_a_started_cluster(tmp_path, cluster):
+    """``uamopt bench --solver windows --scheduler ADDRESS``: a verified row from the started cluster's
+    tasks; with no windows profile the flag is one line, exit code 2, and writes nothing."""
+    import csv
+    import subprocess
+    import sys
+
+    profile = tmp_path / "w.toml"
+    profile.write_text('solver = "windows"\ntime_limit_s = 60.0\nthreads = 1\n[options]\nwindow_flights = 40\n'
+                       'rounds = 40\nwindow_time_limit_s = 30.0\n', encoding="utf-8")
+
+    def run(*args):
+        return subprocess.run([sys.executable, "-m", "uamopt", "bench", "models/paper_case.toml", "--set",
+                               'schedule.objective="weighted"', "--seeds", "1", *args], capture_output=True, text=True,
+                              timeout=300)
+
+    out = tmp_path / "out"
+    done = run("--solver", str(profile), "--scheduler", cluster, "--out", str(out))
+    assert done.returncode == 0, done.stderr
+    with open(out / "bench.csv", encoding="utf-8") as f:
+        rows = list(csv.DictReader(f))
+    assert len(rows) == 1 and rows[0]["verified"] == "True" and rows[0]["solver"] == "windows", rows
+    gone = run("--solver", str(profile), "--scheduler", "tcp://127.0.0.1:9", "--out", str(tmp_path / "gone"))
+    with open(tmp_path / "gone" / "bench.csv", encoding="utf-8") as f:  # the flag was used: nobody listens there
+        (row,) = list(csv.DictReader(f))
+    # exit code 1: a run that is not a verified schedule (an error row), not bad input
+    assert gone.returncode == 1 and row["status"] == "error" and "cannot reach the Dask scheduler" in row["error"], row
+    refused = run("--solver", "greedy", "--scheduler", cluster, "--out", str(tmp_path / "nothing"))
+    lines = refused.stderr.strip().splitlines()
+    assert refused.returncode == 2 and len(lines) == 1 and "--scheduler is for the windows solver" in lines[0]
+    assert not (tmp_path / "nothing").exists()

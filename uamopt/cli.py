@@ -233,6 +233,9 @@ def build_parser() -> argparse.ArgumentParser:
                        "each run's distance to them in bench.csv and bench.md (docs/benchmarks.md)")
     bench.add_argument("--update", action="store_true", help="with --against: record this run's better verified "
                        "objectives and bounds in FILE (rewritten atomically; created if missing)")
+    bench.add_argument("--scheduler", metavar="ADDRESS",
+                       help="the windows profiles: a running Dask scheduler, e.g. tcp://127.0.0.1:8786 "
+                       "(default: a local cluster)")
     bench.set_defaults(func=cmd_bench)
     flight_sources(bench)
     verify = sub.add_parser("verify", help="check a schedule folder independently: exit 0 iff feasible and conflict-free",

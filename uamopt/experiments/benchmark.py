@@ -260,6 +260,12 @@ def cmd_bench(args) -> int:
             raise UamoptError(f"--seeds {' '.join(map(str, args.seeds))} gives no distinct seeds", "--seeds",
                               "give a count (--seeds 3 runs seeds 0, 1, 2) or two or more seeds (--seeds 0 1 2)")
     profiles = _profiles(args.solver, args.time_limit)
+    if getattr(args, "scheduler", None):  # the windows profiles' tasks on a running Dask cluster
+        if not any(p.solver == "windows" for p in profiles):
+            raise UamoptError(f"--scheduler is for the windows solver, not {', '.join(p.solver for p in profiles)}",
+                              "--scheduler", "add a windows profile (--solver windows), or drop --scheduler")
+        profiles = [dataclasses.replace(p, options={**p.options, "scheduler": args.scheduler})
+                    if p.solver == "windows" else p for p in profiles]
     airland = [path for path in args.scenario if is_airland(path)]  # OR-Library landing files: instances as they are
     if airland and (args.set or args.flights or args.network):
         raise UamoptError("--set, --flights and --network do not apply to an airland file", airland[0],

@@ -79,12 +79,10 @@ def _block_stays(occupancy, radius: int) -> tuple[np.ndarray, np.ndarray, np.nda
     return blocks, a, b
 
 
-def occupancy_cliques(problem: SchedulingProblem, start: np.ndarray, step_s: float, kind: str,
-                      cell_ends: tuple[np.ndarray, np.ndarray] | None = None) -> tuple[np.ndarray, np.ndarray]:
+def occupancy_cliques(problem: SchedulingProblem, start: np.ndarray, step_s: float, kind: str
+                      ) -> tuple[np.ndarray, np.ndarray]:
     """The clique rows (module docstring) of the time-indexed model with columns ``start[f] + k``,
-    k ≤ ``start[f+1] − start[f] − 1``, as CSR ``(ptr, cols)``; empty when not :func:`applicable`.
-    ``cell_ends``: (lower, upper) delay per column, for cells of any widths (discovery.py), each column
-    standing for every delay in [lower, upper]; ``step_s`` and ``kind`` are then not read."""
+    k ≤ ``start[f+1] − start[f] − 1``, as CSR ``(ptr, cols)``; empty when not :func:`applicable`."""
     from uamopt.schedule.occupancy import flight_occupancies
 
     none = (np.zeros(1, np.int64), np.zeros(0, np.int64))
@@ -108,24 +106,14 @@ def occupancy_cliques(problem: SchedulingProblem, start: np.ndarray, step_s: flo
     tracks = _shared_or_longest(tracks)
     dep = problem.planned_departure_s
     k_count = np.diff(start)
-    if cell_ends is None:
-        k_all = np.arange(int(start[-1])) - np.repeat(start[:-1], k_count)
-        col_lo = k_all * step_s
-        col_hi = (k_all + (1 if kind == "relaxed" else 0)) * step_s
-    else:
-        col_lo, col_hi = (np.asarray(c, dtype=float) for c in cell_ends)
-    reach = np.zeros(len(k_count))  # each flight's latest delay start
-    some = k_count > 0
-    if some.any():
-        reach[some] = np.maximum.reduceat(col_lo, start[:-1][some])
-    company = _in_company(tracks, key, dep, reach)
+    company = _in_company(tracks, key, dep, (k_count - 1) * step_s)
     parts: list[tuple[np.ndarray, ...]] = []
     for f in range(problem.n_flights):
         code, a, b = tracks[key[f]]
         code, a, b = code[company[f]], a[company[f]], b[company[f]]
         k = np.arange(k_count[f])[:, None]
-        lo = dep[f] + col_hi[start[f]:start[f + 1], None] + a[None, :] + TIME_TOL_S
-        hi = dep[f] + col_lo[start[f]:start[f + 1], None] + b[None, :] - TIME_TOL_S
+        lo = dep[f] + (k + (1 if kind == "relaxed" else 0)) * step_s + a[None, :] + TIME_TOL_S
+        hi = dep[f] + k * step_s + b[None, :] - TIME_TOL_S
         ok = hi > lo
         if ok.any():
             parts.append((np.broadcast_to(code, lo.shape)[ok], lo[ok], hi[ok],

@@ -489,7 +489,7 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
         if searchable:
             operated, delay, better = lns.improve(problem, small, operated, delay, t0 + limit, profile.threads,
                                                   profile.seed, size=o("lns_window"),
-                                                  window_s=o("lns_window_time_limit_s"))
+                                                  window_s=o("lns_window_time_limit_s"), pass_index=passes)
             windows += better
             passes += 1
         if better:

@@ -364,8 +364,11 @@ def run_highs(model: GridModel, deadline: float, threads: int, seed: int, gap: f
     run = run_mip(h, deadline, "solver timeindexed")  # what the model's loading left of the limit
     x = run.x
     if hint is not None and x is not None and abs(float(model.cost @ x) - run.objective) > 1e-6 * (
-            1.0 + abs(run.objective)):  # a solution that is not the one reported: trust neither
-        return run_highs(model, deadline, threads, seed, gap, None, presolve)
+            1.0 + abs(run.objective)):  # a solution that is not the one reported: trust neither (the dual bound holds)
+        again = run_highs(model, deadline, threads, seed, gap, None, presolve)
+        if run.bound is not None and (again.bound is None or again.bound < run.bound):
+            again = dataclasses.replace(again, bound=run.bound)
+        return again
     bound = run.bound
     if run.proved and x is not None:
         bound = min(bound, float(model.cost @ np.round(x))) if bound is not None else float(model.cost @ np.round(x))

@@ -148,7 +148,7 @@ def solve(problem: SchedulingProblem, profile: SolverProfile) -> Schedule:
     while time.perf_counter() - t0 < profile.time_limit_s - 2.0:
         operated, delay, better = lns.improve(problem, small, operated, delay, t0 + profile.time_limit_s,
                                               profile.threads, profile.seed, size=o("lns_window"),
-                                              window_s=o("lns_window_time_limit_s"))
+                                              window_s=o("lns_window_time_limit_s"), pass_index=passes)
         passes += 1
         if not better:
             break
