@@ -66,6 +66,7 @@ in the delay (not earliness/tardiness): :data:`SHAPES`, :data:`OBJECTIVES`.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from dataclasses import dataclass, field
@@ -281,6 +282,25 @@ def lifted_cliques(problem: SchedulingProblem, step_s: float) -> Lifted:
     return Lifted(step_s=float(step_s), ptr=ptr, col=col, ustart=ustart)
 
 
+def lp_bound(model, deadline: float, threads: int) -> float | None:
+    """The LP relaxation's optimum of a relaxation model (a bound of it, so of the continuous
+    problem), or None when HiGHS does not reach it by ``deadline``: the bound of a round whose
+    MILP stopped before its root LP."""
+    import highspy
+
+    from uamopt.solvers.timeindexed import load_model
+
+    h = highspy.Highs()
+    h.setOptionValue("output_flag", False)
+    h.setOptionValue("threads", int(threads))
+    h.setOptionValue("time_limit", max(0.05, deadline - time.perf_counter()))
+    load_model(h, model, integer=False)
+    h.run()
+    if h.getModelStatus() != highspy.HighsModelStatus.kOptimal:
+        return None
+    return float(h.getInfo().objective_function_value)
+
+
 def point(x: np.ndarray, start: np.ndarray, lower: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Operated flags and the cells' lower ends of a 0-1 vector."""
     n = len(start) - 1
@@ -381,6 +401,8 @@ def discover(problem: SchedulingProblem, small: SchedulingProblem, deadline: flo
         if capped and round_s is not None and bound is not None and (
                 run.bound is None or run.bound < bound - max(gap, 1e-3) * abs(bound)):
             round_s *= 2.0  # the cap stopped HiGHS before its root's cuts: later rounds get twice as long
+        if run.bound is None and bound is None and time.perf_counter() < deadline:
+            run = dataclasses.replace(run, bound=lp_bound(model, deadline, threads))  # no bound yet: the LP's
         if run.bound is not None:  # every round's relaxation bounds the continuous optimum
             bound = run.bound if bound is None else max(bound, run.bound)
         if run.x is None:  # no point within the round's cap: the next round gets twice as long
