@@ -27,7 +27,7 @@ from strategies import tiny_problems
 
 from uamopt.schedule import build_problem, generate_plan
 from uamopt.solvers import SolverProfile, solve
-from uamopt.solvers.discovery import Cells, Constraints, build, cut, discover, point
+from uamopt.solvers.discovery import Cells, Constraints, build, cut, discover, lifted_cliques, point
 from uamopt.solvers.lns import improve, neighbourhoods
 from uamopt.solvers.polish import Neighbours, mend, polish
 from uamopt.solvers.timeindexed import run_highs
@@ -101,6 +101,36 @@ def test_a_cut_forbids_the_point_that_broke_a_row(dense_problem):
     model, lower, _ = build(small, cells, cons, None)
     x = cells.cell_of(delay, operated, model.start)
     assert _row_sums(model, x).max() > 1
+
+
+def test_clique_rows_act_from_2_s_cells_and_hold_lifted_onto_cut_cells(dense_problem):
+    """Option ``cliques``: no rows from 10 s cells, thousands from 2 s cells; lifted onto randomly cut
+    cells, every row of the model (pairs, turnarounds, cliques) holds at the cells of schedules that
+    the oracle of tests/oracles.py finds feasible (mended from random points, so crowded)."""
+    small = reduced(dense_problem)
+    assert len(lifted_cliques(small, 10.0).ptr) == 1  # none: why the option is off by default
+    lifted = lifted_cliques(small, 2.0)
+    cells = Cells.uniform(small, 2.0)
+    rng = np.random.default_rng(4)
+    for f in range(small.n_flights):
+        if float(cells.upper[f]) > 0:
+            cells.add(np.full(4, f), rng.uniform(0.0, float(cells.upper[f]), 4))
+    cons = Constraints.of(small)
+    model, _, _ = build(small, cells, cons, lifted)
+    plain, _, _ = build(small, cells, cons, None)
+    assert model.cliques >= 1000 and model.n_rows != plain.n_rows
+    data = model_data(dense_problem)
+    nb = Neighbours(small)
+    hits = 0
+    for trial in range(8):
+        operated = rng.random(small.n_flights) < 0.9
+        delay = np.where(operated, rng.uniform(0, 1, small.n_flights) * small.delay_upper_s, 0.0)
+        op, d = mend(small, nb, operated, delay)
+        assert broken(data, op, d) == [], trial
+        sums = _row_sums(model, cells.cell_of(d, op, model.start))
+        assert sums.max() <= 1 + 1e-9, trial
+        hits += int(np.sum(sums[len(sums) - model.cliques:] > 0.5))
+    assert hits > 0  # the schedules' cells lie in clique rows: the check is not vacuous
 
 
 def _row_sums(model, x: np.ndarray) -> np.ndarray:

@@ -62,8 +62,24 @@ def test_bound_below_the_proved_optimum_and_schedule_feasible(day):
     assert result.bound is not None and result.bound <= best + OBJ_TOL
     assert score(data, result.operated, result.delay_s) >= best - OBJ_TOL
     assert result.extras["windows"] == 3 and result.extras["windows_at_limit"] == 0
+    assert result.extras["clique_rows"] == 0  # option cliques: off by default
     # the dropped rows cost little here: the bound is within 5 % of the optimum (regression value: 2.9 %)
     assert best - result.bound <= 0.05 * abs(best)
+
+
+@pytest.mark.parametrize("solver", ["discovery", "windows"])
+def test_the_cliques_option_acts_from_2_s_cells_and_the_bound_stays_valid(day, solver):
+    """Option ``cliques`` with 2 s cells: clique rows in the relaxations (none at the default 10 s),
+    the schedule feasible and the bound still below the optimum the continuous MILP proves."""
+    problem, best = day
+    options = {"step_s": 2.0, "cliques": True}
+    result = (_run(problem, workers=1, **options) if solver == "windows"
+              else solve(problem, SolverProfile("discovery", time_limit_s=60.0, threads=1, options=options)))
+    assert result.extras["clique_rows"] > 0
+    data = model_data(problem)
+    assert broken(data, result.operated, result.delay_s) == []
+    assert result.bound is not None and result.bound <= best + OBJ_TOL
+    assert score(data, result.operated, result.delay_s) >= best - OBJ_TOL
 
 
 def test_same_answer_on_one_or_two_workers_and_on_a_started_cluster(day, cluster):
