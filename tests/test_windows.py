@@ -82,6 +82,22 @@ def test_the_cliques_option_acts_from_2_s_cells_and_the_bound_stays_valid(day, s
     assert score(data, result.operated, result.delay_s) >= best - OBJ_TOL
 
 
+def test_the_neighbourhood_options_act_on_the_joined_schedule(day):
+    """``lns_window_time_limit_s`` and ``lns_window``: with a millisecond per neighbourhood no window
+    is solved, so none improves the joined schedule; with the default time some do (the joined
+    schedule of 40-flight windows is mended, not optimal: regression observation, 120 flights)."""
+    problem, best = day
+    starved = _run(problem, workers=1, lns_window_time_limit_s=0.001)
+    fed = _run(problem, workers=1, lns_window=60)
+    assert starved.extras["lns_windows_improved"] == 0 and starved.extras["lns_passes"] == 1
+    assert fed.extras["lns_windows_improved"] > 0
+    data = model_data(problem)
+    assert score(data, fed.operated, fed.delay_s) < score(data, starved.operated, starved.delay_s) - 1e-6
+    for result in (starved, fed):
+        assert broken(data, result.operated, result.delay_s) == []
+        assert score(data, result.operated, result.delay_s) >= best - OBJ_TOL
+
+
 def test_same_answer_on_one_or_two_workers_and_on_a_started_cluster(day, cluster):
     problem, _ = day
     runs = [_run(problem, workers=1), _run(problem, workers=2), _run(problem, scheduler=cluster)]

@@ -148,12 +148,13 @@ def solve(problem: SchedulingProblem, profile: SolverProfile) -> Schedule:
     bound = float(sum(bounds)) if all(b is not None for b in bounds) else None
     operated, delay = join(problem, list(zip(windows, results, strict=True)))
     small = reduced(problem)
-    passes = 0
+    passes = improved = 0
     while time.perf_counter() - t0 < profile.time_limit_s - 2.0:
         operated, delay, better = lns.improve(problem, small, operated, delay, t0 + profile.time_limit_s,
                                               profile.threads, profile.seed, size=o("lns_window"),
                                               window_s=o("lns_window_time_limit_s"), pass_index=passes)
         passes += 1
+        improved += better
         if not better:
             break
     assert not violations(problem, operated, delay), "the joined schedule breaks a row"
@@ -167,6 +168,7 @@ def solve(problem: SchedulingProblem, profile: SolverProfile) -> Schedule:
               "windows_at_limit": int(sum(bool(r["at_limit"]) for r in results)),
               "windows_proved": int(sum(bool(r["proved"]) for r in results)),
               "window_seconds": [round(r["seconds"], 1) for r in results], "lns_passes": passes,
+              "lns_windows_improved": improved,
               "warm_start": f"{start.source} {start.objective:.6f}", "continuous_bound": bound,
               "continuous_bound_model": "sum over windows of discovery relaxations (cross-window rows dropped)"}
     schedule = make_schedule(problem, "windows", "optimal" if proved else "time_limit", operated, delay, bound=bound,
