@@ -27,7 +27,7 @@ from strategies import tiny_problems
 
 from uamopt.schedule import build_problem, generate_plan
 from uamopt.solvers import SolverProfile, solve
-from uamopt.solvers.discovery import Cells, Constraints, build, cut, discover, lifted_cliques, point
+from uamopt.solvers.discovery import Cells, Constraints, build, cut, discover, lifted_cliques, lp_bound, point
 from uamopt.solvers.lns import improve, neighbourhoods
 from uamopt.solvers.polish import Neighbours, mend, polish
 from uamopt.solvers.timeindexed import run_highs
@@ -81,6 +81,21 @@ def test_every_forbidden_cell_pair_holds_only_forbidden_delays(dense_problem):
                     assert pair_broken(data, f, g, d_f, d_g, tol_s=0.0), (r, f, g, d_f, d_g)
             checked += 1
     assert checked >= 500  # dense: the check is not vacuous
+
+
+def test_the_lp_bound_lies_below_the_relaxations_optimum_and_above_its_cheapest_columns(dense_problem):
+    """lp_bound (a round cut short before any bound): at most the 0-1 optimum HiGHS proves for the same
+    relaxation, and at least the sum of each flight's cheapest column (what the LP can do with no row)."""
+    small = reduced(dense_problem)
+    model, _, _ = build(small, Cells.uniform(small, 10.0), Constraints.of(small), None)
+    lp = lp_bound(model, time.perf_counter() + 60.0, 1)
+    milp = run_highs(model, time.perf_counter() + 60.0, 1, 0, 0.0, None)
+    assert lp is not None and milp.proved
+    optimum = float(model.cost @ np.round(milp.x))
+    assert lp <= optimum + OBJ_TOL
+    cheapest = sum(min(0.0, float(model.cost[a:b].min())) for a, b in zip(model.start[:-1], model.start[1:], strict=True))
+    assert lp >= cheapest - OBJ_TOL and lp < optimum - 1e-6  # the rows bind, and the LP is weaker here
+    assert lp_bound(model, time.perf_counter() - 1.0, 1) is None  # no time: no bound
 
 
 def test_a_cut_forbids_the_point_that_broke_a_row(dense_problem):

@@ -288,19 +288,13 @@ def lp_bound(model, deadline: float, threads: int) -> float | None:
     """The LP relaxation's optimum of a relaxation model (a bound of it, so of the continuous
     problem), or None when HiGHS does not reach it by ``deadline``: the bound of a round whose
     MILP stopped before its root LP."""
-    import highspy
-
+    from uamopt.solvers.highs import mip_solver, run_mip
     from uamopt.solvers.timeindexed import load_model
 
-    h = highspy.Highs()
-    h.setOptionValue("output_flag", False)
-    h.setOptionValue("threads", int(threads))
-    h.setOptionValue("time_limit", max(0.05, deadline - time.perf_counter()))
+    h = mip_solver(threads, 0, 0.0)
     load_model(h, model, integer=False)
-    h.run()
-    if h.getModelStatus() != highspy.HighsModelStatus.kOptimal:
-        return None
-    return float(h.getInfo().objective_function_value)
+    run = run_mip(h, deadline, "solver discovery (a round's LP bound)")
+    return run.objective if run.proved else None
 
 
 def point(x: np.ndarray, start: np.ndarray, lower: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
