@@ -23,6 +23,11 @@ settings.register_profile("ci", derandomize=True, print_blob=True)
 settings.register_profile("dev", print_blob=True)
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE") or ("ci" if os.environ.get("CI") else "dev"))
 
+#: every solve of the suite on one thread (uamopt.solvers.THREADS_ENV): two pytest workers share the 2
+#: cores, and HiGHS's threads spin against each other when they outnumber them (a solve 3x slower at
+#: load 4). Tests about threads unset it with monkeypatch.
+os.environ.setdefault("UAMOPT_MAX_THREADS", "1")
+
 #: the longest test files (10-60 s each on 2 cores), run first: ``make test``'s two workers take
 #: whole files in collection order, and a long file taken last leaves the other worker idle
 LONGEST_FIRST = ("test_notebooks.py", "test_replay.py", "test_sweep.py", "test_variants.py", "test_output_safety.py",

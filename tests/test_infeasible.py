@@ -93,13 +93,17 @@ def test_raise_for_status_names_the_reason_and_nothing_is_written(name, tmp_path
     assert solved.raise_for_status() is solved  # a schedule: returned as it is
 
 
-def test_highs_after_a_one_thread_solve_in_the_same_process():
+def test_highs_after_a_one_thread_solve_in_the_same_process(monkeypatch):
     """HiGHS sizes one thread pool per process at its first run. A 1-thread time-indexed solve, then
     the MILP with 2 threads and no MIP start (nothing feasible to start from): before, that run
     stopped at once with model status "Not Set" (an error line, seen in `make test` when a file of
-    1-thread solves ran before this one); now it proves the instance infeasible."""
+    1-thread solves ran before this one); now it proves the instance infeasible. Both in this process
+    (``isolated = false``: a watched solve has a process of its own) and with no thread cap."""
+    from uamopt.solvers import THREADS_ENV
+
+    monkeypatch.delenv(THREADS_ENV, raising=False)
     feasible = dataclasses.replace(crossing("weighted"), must_operate=np.array([True, False]))
-    first = ua.solve(feasible, "timeindexed", time_limit_s=20, threads=1)
+    first = ua.solve(feasible, "timeindexed", time_limit_s=20, threads=1, isolated=False)
     assert first.status == "optimal_on_grid"
-    schedule = ua.solve(crossing("weighted"), "highs", time_limit_s=20, threads=2)
+    schedule = ua.solve(crossing("weighted"), "highs", time_limit_s=20, threads=2, isolated=False)
     assert schedule.status == "infeasible" and "A1" in schedule.extras["reason"]

@@ -24,6 +24,9 @@ class UamoptError(Exception):
         self.what, self.where, self.fix = what, where, fix
         super().__init__(self.line())
 
+    def __reduce__(self):  # pickled whole (a watched solver's child process sends its errors)
+        return _rebuild, (type(self), self.__dict__)
+
     def line(self) -> str:
         text = self.what
         if self.where:
@@ -31,6 +34,14 @@ class UamoptError(Exception):
         if self.fix:
             text += f": {self.fix}"
         return printable(text)
+
+
+def _rebuild(cls: type, state: dict) -> UamoptError:
+    """A pickled :class:`UamoptError` (or subclass, whatever its ``__init__``), with its state."""
+    error = Exception.__new__(cls)
+    error.__dict__.update(state)
+    Exception.__init__(error, error.line())
+    return error
 
 
 class ScenarioError(UamoptError):

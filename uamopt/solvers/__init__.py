@@ -17,6 +17,7 @@ Every field and option is typed and checked when the profile is made (:mod:`uamo
 
 from __future__ import annotations
 
+import dataclasses
 import importlib
 import tomllib
 from dataclasses import dataclass, field
@@ -44,7 +45,7 @@ SOLVERS = {
 }
 #: the shipped profiles (package data, read with importlib.resources: :func:`uamopt.shipped.profiles_dir`)
 PROFILE_DIR = profiles_dir()
-_KEYS = {"solver", "time_limit_s", "seed", "threads", "options", "description"}
+_KEYS = {"solver", "time_limit_s", "seed", "threads", "isolated", "options", "description"}
 
 
 @dataclass(frozen=True)
@@ -59,6 +60,7 @@ class SolverProfile:
     seed: int = 0
     threads: int = 2
     options: dict = field(default_factory=dict)
+    isolated: bool = True
 
     def __post_init__(self) -> None:
         from uamopt.solvers.options import check_options, check_profile_fields
@@ -67,6 +69,10 @@ class SolverProfile:
             raise UamoptError(f"unknown solver {self.solver!r}", f"profile {self.name or self.solver}",
                               f"use one of {', '.join(SOLVERS)}")
         check_profile_fields(self.name or self.solver, self.time_limit_s, self.seed, self.threads)
+        if not isinstance(self.isolated, bool):
+            raise UamoptError(f"isolated must be true or false, got {self.isolated!r}"[:200],
+                              f"profile {self.name or self.solver}",
+                              "write isolated = true (a child process its time limit can end) or false")
         try:  # options passed through to HiGHS or CP-SAT are checked by them: the [exact] extra
             check_options(self.solver, self.options, self.name or self.solver)
         except ModuleNotFoundError as exc:
@@ -119,7 +125,8 @@ def load_profile(name_or_path: str | Path) -> SolverProfile:
     if "solver" not in raw:
         raise ScenarioError("missing key 'solver'", str(path), f"name one of {', '.join(SOLVERS)}")
     return SolverProfile(solver=raw["solver"], name=path.stem, time_limit_s=raw.get("time_limit_s", 60.0),
-                         seed=raw.get("seed", 0), threads=raw.get("threads", 2), options=raw.get("options", {}))
+                         seed=raw.get("seed", 0), threads=raw.get("threads", 2), options=raw.get("options", {}),
+                         isolated=raw.get("isolated", True))
 
 
 #: solvers whose model accepts ``extra=`` callbacks (docs/variants.md): highs gets ``extra(m, problem)``
@@ -186,21 +193,56 @@ def solve(problem: SchedulingProblem, profile: SolverProfile | str, *, extra=Non
     if not isinstance(profile, SolverProfile):
         profile = load_profile(profile)
     check_supported(profile.solver, problem, f"profile {profile.name or profile.solver}")
-    module = solver_module(profile.solver)
     if extra is not None and profile.solver not in EXTRA:
         raise UamoptError(f"solver {profile.solver} takes no extra= callback", f"profile {profile.name or profile.solver}",
                           f"use one of {', '.join(EXTRA)}, whose models the callback can edit")
+    from uamopt.solvers import watchdog
+
+    profile = capped_threads(profile)
+    schedule = watchdog.run(problem, profile, extra, solve_here)
+    schedule.extras.setdefault("model_kind", model_kind(profile, problem))
+    schedule.extras["threads"] = profile.threads
+    if profile.solver in watchdog.WATCHED and schedule.bound is None and schedule.objective is not None:
+        # a bound is always reported: where the solver's own gave none, the separable one (weak, valid)
+        bound = min(watchdog.separable_bound(problem), schedule.objective)
+        schedule.extras.setdefault("bound_source", "the separable bound (every flight at its own best choice)")
+        schedule = dataclasses.replace(schedule, bound=bound,
+                                       gap=abs(schedule.objective - bound) / max(abs(schedule.objective), 1e-10))
+    return schedule
+
+
+#: an environment variable capping every solver's threads: for a machine whose cores several solves
+#: share (HiGHS's threads spin against each other when they outnumber the cores: airland1's time-indexed
+#: model took 159 s on 2 threads and 49 s on 1 at load 4). The test suite sets it to 1 (tests/conftest.py).
+THREADS_ENV = "UAMOPT_MAX_THREADS"
+
+
+def capped_threads(profile: SolverProfile) -> SolverProfile:
+    """``profile`` with its threads at most ``$UAMOPT_MAX_THREADS`` (unset or empty: no cap)."""
+    import dataclasses
+    import os
+
+    raw = os.environ.get(THREADS_ENV, "").strip()
+    if not raw:
+        return profile
+    if not raw.isdigit() or len(raw) > 6 or int(raw) < 1:
+        raise UamoptError(f"{THREADS_ENV} must be a whole number of at least 1, got {raw[:40]!r}", "the environment",
+                          f"unset it, or set e.g. {THREADS_ENV}=1")
+    return profile if profile.threads <= int(raw) else dataclasses.replace(profile, threads=int(raw))
+
+
+def solve_here(problem: SchedulingProblem, profile: SolverProfile, extra=None) -> Schedule:
+    """:func:`solve`'s work in this process, with no watchdog (a watched child runs this)."""
     from uamopt.schedule.families.speed import speed_choice_of
 
+    module = solver_module(profile.solver)
     choice = speed_choice_of(problem)
     try:  # a solver's own lazy imports (OR-Tools, HiGHS inside rolling, timeindexed): the [exact] extra
         if choice is not None and profile.solver in SPEED_FIRST and extra is None:
             return _speed_solve(problem, profile, module, choice)
-        schedule = module.solve(problem, profile) if extra is None else module.solve(problem, profile, extra=extra)
+        return module.solve(problem, profile) if extra is None else module.solve(problem, profile, extra=extra)
     except ModuleNotFoundError as exc:
         raise (missing_extra(exc, f"the {profile.solver} solver") or exc) from None
-    schedule.extras.setdefault("model_kind", model_kind(profile, problem))
-    return schedule
 
 
 #: exact solvers that solve the cruise-speed model first when a problem has speed options, and

@@ -79,6 +79,7 @@ import numpy as np
 from uamopt.schedule.flights import TIME_TOL_S
 from uamopt.schedule.model import Schedule, SchedulingProblem, evaluate, make_schedule, violations
 from uamopt.solvers.warmstart import no_worse
+from uamopt.solvers.watchdog import report_bound, report_incumbent
 
 ETA_S = 1e-9  # float round-off forgiven when mapping a delay to its cell, s
 ROUND_S = 1e-9  # float round-off forgiven in the forbidden test, s
@@ -402,6 +403,7 @@ def discover(problem: SchedulingProblem, small: SchedulingProblem, deadline: flo
             run = dataclasses.replace(run, bound=lp_bound(model, deadline, threads))  # no bound yet: the LP's
         if run.bound is not None:  # every round's relaxation bounds the continuous optimum
             bound = run.bound if bound is None else max(bound, run.bound)
+            report_bound(problem, bound, "a discovery round's relaxation")
         if run.x is None:  # no point within the round's cap: the next round gets twice as long
             rounds.append(Round(model.n_cols, model.n_rows, run.bound, None, run.proved, 0, 0, None,
                                 time.perf_counter() - t, t_built - t, t_solved - t_built, run.termination))
@@ -451,6 +453,8 @@ def discover(problem: SchedulingProblem, small: SchedulingProblem, deadline: flo
                     added += cells.add(np.asarray(who, dtype=np.int64), np.asarray(ends))
         rounds.append(Round(model.n_cols, model.n_rows, run.bound, value, run.proved, len(pair) + len(turn), added,
                             repaired, time.perf_counter() - t, t_built - t, t_solved - t_built, run.termination))
+        if best_x is not None:
+            report_incumbent(problem, *best_x, f"discovery round {len(rounds)}")
         if log is not None:
             log(rounds[-1], bound, best_value)
         rel = (best_value - bound) / max(1e-9, abs(best_value)) if bound is not None and math.isfinite(best_value) else 1.0
@@ -511,6 +515,8 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
                                                   window_s=o("lns_window_time_limit_s"), pass_index=passes)
             windows += better
             passes += 1
+            if better:
+                report_incumbent(problem, operated, delay, f"neighbourhood search pass {passes}")
         if better:
             continue
         # the search is stuck: the time left goes back to discovery, from its cells and schedule

@@ -23,13 +23,19 @@ from uamopt.errors import UamoptError
 from uamopt.interrupts import stopping
 
 
-def interrupt_at(highs, deadline: float, grace_s: float = 0.05) -> list:
+def interrupt_at(highs, deadline: float, grace_s: float = 0.05, on_bound=None) -> list:
     """Make ``highs`` (a ``highspy.Highs``) stop once ``time.perf_counter()`` passes ``deadline``.
     Returns a list that is non-empty once it has stopped HiGHS (HiGHS then reports "interrupted by
-    user", which Pyomo reads as an unknown termination: it is the time limit)."""
+    user", which Pyomo reads as an unknown termination: it is the time limit). ``on_bound(value)``,
+    if given, hears the MIP's dual bound at each of HiGHS's MIP callbacks (a watched child passes it
+    on: uamopt.solvers.watchdog)."""
     fired: list = []
 
     def stop(event) -> None:
+        if on_bound is not None:
+            bound = getattr(getattr(event, "data_out", None), "mip_dual_bound", None)
+            if bound is not None and math.isfinite(bound):
+                on_bound(float(bound))
         if time.perf_counter() > deadline + grace_s:
             fired.append(True)
             event.interrupt()

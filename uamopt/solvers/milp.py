@@ -60,6 +60,7 @@ from uamopt.interrupts import quiet_on_interrupt, stopping
 from uamopt.schedule.flights import TIME_TOL_S
 from uamopt.schedule.model import Schedule, SchedulingProblem, Status, make_schedule
 from uamopt.solvers.highs import interrupt_at, start_solution
+from uamopt.solvers.watchdog import report_bound
 
 if TYPE_CHECKING:
     from uamopt.solvers import SolverProfile
@@ -440,7 +441,8 @@ def solve(problem: SchedulingProblem, profile: SolverProfile, extra=None) -> Sch
         _set_mip_start(solver, mip_start(m, problem, *start.decisions))
     stopped: list = []
     if getattr(solver, "_solver_model", None) is not None:  # pyomo 6.10's persistent HiGHS object
-        stopped = interrupt_at(solver._solver_model, t0 + profile.time_limit_s)  # where HiGHS listens (solvers/highs.py)
+        stopped = interrupt_at(solver._solver_model, t0 + profile.time_limit_s,  # where HiGHS listens (solvers/highs.py)
+                               on_bound=lambda b: report_bound(problem, b, "HiGHS's dual bound"))
     left = profile.time_limit_s - (time.perf_counter() - t0)
     if left <= 0.05:
         return _start_only(problem, profile, start, t0, f"the time limit ran out while building the MILP ({build_s:.1f} s)")

@@ -82,6 +82,7 @@ from uamopt.schedule.flights import TIME_TOL_S
 from uamopt.schedule.model import Schedule, SchedulingProblem, Status, evaluate, make_schedule
 from uamopt.solvers.highs import highs_can_start, mip_solver, run_mip, start_solution
 from uamopt.solvers.warmstart import Start, no_schedule, no_worse, reduced, warm_start
+from uamopt.solvers.watchdog import report_incumbent
 
 if TYPE_CHECKING:
     from uamopt.solvers import SolverProfile
@@ -507,6 +508,7 @@ def _refine(small: SchedulingProblem, problem: SchedulingProblem, profile: Solve
     decisions = coarse.decode(result.x) if result.x is not None else start.decisions
     if result.x is not None and start.found and start.objective < evaluate(problem, *decisions) - 1e-12:
         decisions = start.decisions
+    report_incumbent(problem, *decisions, f"the {coarse.step_s:g} s grid's best")  # a watched child's answer so far
     t = time.perf_counter()
     fine = build_grid_model(small, fine_step, "grid", both_ways=engine == "cpsat", cliques=profile.option("cliques"))
     hint = fine.columns_of(*decisions)

@@ -46,6 +46,7 @@ from uamopt.schedule.model import (
     violations,
 )
 from uamopt.solvers.greedy import DEFAULT_STEP_S, greedy_decisions
+from uamopt.solvers.watchdog import report_incumbent
 
 
 @dataclass(frozen=True)
@@ -130,6 +131,7 @@ def warm_start(problem: SchedulingProblem, step_s: float = DEFAULT_STEP_S, *, so
     t0 = time.perf_counter()
     small = reduced(problem)
     candidates = [("greedy", *greedy_decisions(problem, step_s))]
+    report_incumbent(problem, candidates[0][1], candidates[0][2], "warm start (greedy)")  # a watched child's first answer
     candidates += [(name, op, d) for name, op, d in SEEDS.get(id(problem), ())
                    if not on_grid or np.allclose(np.where(op, d, 0.0) / step_s, np.rint(np.where(op, d, 0.0) / step_s))]
     if small is not problem:
@@ -155,6 +157,7 @@ def warm_start(problem: SchedulingProblem, step_s: float = DEFAULT_STEP_S, *, so
         return Start(operated=None, delay_s=None, objective=math.inf,
                      source="none (no cheap schedule operates every must-operate flight)",
                      seconds=time.perf_counter() - t0)
+    report_incumbent(problem, best[2], best[3], f"warm start ({best[1]})")
     return Start(operated=best[2].copy(), delay_s=np.where(best[2], best[3], 0.0), objective=best[0], source=best[1],
                  seconds=time.perf_counter() - t0)
 

@@ -1,0 +1,344 @@
+"""A time limit is a promise: a watched solve returns by ``time_limit_s × 1.05 + 5 s``, whatever its
+engine does.
+
+Why a process. HiGHS checks neither its time limit nor its interrupt callbacks in parts of its
+presolve: a ``solvers/exact.toml`` run of 300 s on 600 flights of the paper city ran 674 s under load,
+its main thread in ``HPresolve::enumerateSolutions`` → ``HighsCliqueTable::runCliqueMerging``. Nothing
+inside the process can stop such a call. So the exact solvers (:data:`WATCHED`) run in a child
+process, started from a ``forkserver`` that has the solver libraries imported already (tens of
+milliseconds a solve), and this process keeps the clock:
+
+- the child gets the time left to the parent's deadline (process start included) and keeps to it by
+  its own means (HiGHS's limit and interrupt callback, CP-SAT's limit, the rounds' caps);
+- while it runs it reports, through a pipe, every complete schedule it holds (the warm start, each
+  round's mended point, each stage's best: :func:`report_incumbent`) and every bound valid for the
+  continuous model (:func:`report_bound`);
+- at :func:`kill_at` (``limit × 1.03 + 2 s``) a child that has not answered is ended (SIGKILL), and
+  the answer is its best reported schedule, checked against the model here, with status
+  ``time_limit``, the best reported bound or, if none came, the separable bound
+  (:func:`separable_bound`: every flight at its own best choice, no pair or turnaround rows), so
+  a bound is always reported; ``extras["watchdog"]`` says what happened.
+
+Ctrl-C and SIGTERM are this process's: the child is in its own process group (a terminal's Ctrl-C
+does not reach it), is ended at once, and the interrupt goes on as before (uamopt.interrupts). A
+child whose parent dies ends itself (it watches a pipe whose other end only the parent holds).
+
+Where a child cannot be had, the solve runs in this process and says so in ``extras["watchdog"]``:
+inside a daemonic process (a Dask worker of a cluster uamopt did not start: uamopt's own clusters
+start their workers non-daemonic), with an ``extra=`` callback that cannot be pickled (a lambda:
+pass a module-level function to keep the promise), or with ``isolated = false`` in the profile.
+"""
+
+from __future__ import annotations
+
+import math
+import multiprocessing as mp
+import os
+import pickle
+import signal
+import threading
+import time
+from collections.abc import Iterator
+from contextlib import contextmanager
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from uamopt.errors import UamoptError
+
+if TYPE_CHECKING:
+    from uamopt.schedule.model import Schedule, SchedulingProblem
+    from uamopt.solvers import SolverProfile
+
+#: the promise: a watched solve returns within limit × (1 + MARGIN_SHARE) + MARGIN_S seconds
+MARGIN_SHARE, MARGIN_S = 0.05, 5.0
+#: a child still running at limit × (1 + KILL_SHARE) + KILL_S is ended; the rest of the margin is for
+#: ending it and making the answer here
+KILL_SHARE, KILL_S = 0.03, 2.0
+#: the solvers run in a child process (the heuristics keep time in Python, between their own steps)
+WATCHED = frozenset({"highs", "cpsat", "timeindexed", "discovery", "rolling"})
+#: imported by the forkserver once, so that a child starts with them loaded
+PRELOAD = ["numpy", "scipy.sparse", "scipy.optimize", "highspy", "pyomo.environ", "ortools.sat.python.cp_model",
+           "uamopt.schedule.model", "uamopt.solvers.milp", "uamopt.solvers.cpsat", "uamopt.solvers.timeindexed",
+           "uamopt.solvers.discovery", "uamopt.solvers.rolling"]
+
+
+def promised_s(limit_s: float) -> float:
+    """The seconds a watched solve of limit ``limit_s`` returns within."""
+    return limit_s * (1.0 + MARGIN_SHARE) + MARGIN_S
+
+
+def kill_at(limit_s: float) -> float:
+    """Seconds after the start at which a child that has not answered is ended."""
+    return limit_s * (1.0 + KILL_SHARE) + KILL_S
+
+
+# --- the child's side: reports ------------------------------------------------------------------
+
+_CHANNEL: Any = None  # the child's end of the pipe to its parent (None: not in a watched child)
+_TOP: int | None = None  # id() of the problem the parent asked for: only its schedules and bounds count
+_LOCK = threading.Lock()  # CP-SAT calls back from its own threads
+_LAST_BOUND = [-math.inf, 0.0]  # the best bound sent, and when (bounds are sent at most once a second)
+
+
+def watched(problem) -> bool:
+    """Whether reports about ``problem`` go anywhere (a watched child solving exactly this problem)."""
+    return _CHANNEL is not None and id(problem) == _TOP
+
+
+def _send(message: tuple) -> None:
+    with _LOCK:
+        try:
+            _CHANNEL.send(message)
+        except (OSError, ValueError):  # the parent is gone or closed the pipe: the lifeline ends us
+            pass
+
+
+def report_incumbent(problem, operated: np.ndarray, delay_s: np.ndarray, source: str) -> None:
+    """Tell the parent about a complete schedule of ``problem`` (feasible as far as the caller knows;
+    the parent checks it before using it). A no-op outside a watched child or for another problem."""
+    if watched(problem):
+        _send(("incumbent", np.asarray(operated, dtype=bool).copy(), np.asarray(delay_s, dtype=float).copy(), str(source)))
+
+
+def report_bound(problem, bound: float | None, source: str) -> None:
+    """Tell the parent about a lower bound on ``problem``'s optimum valid for continuous delays
+    (at most once a second unless it improved by more than 1e-9 relative). A no-op outside a
+    watched child, for another problem, or for a bound that is not finite."""
+    if not watched(problem) or bound is None or not math.isfinite(bound):
+        return
+    now = time.monotonic()
+    if bound <= _LAST_BOUND[0] + 1e-9 * (1.0 + abs(bound)) and now - _LAST_BOUND[1] < 1.0:
+        return
+    if bound > _LAST_BOUND[0]:
+        _LAST_BOUND[0] = float(bound)
+    _LAST_BOUND[1] = now
+    _send(("bound", float(bound), str(source)))
+
+
+def _lifeline(conn) -> None:
+    """End this child once its parent's end of ``conn`` closes (the parent ended, however)."""
+    try:
+        conn.recv()
+    except (EOFError, OSError):
+        pass
+    os._exit(1)
+
+
+def _child(channel, lifeline, problem, profile, extra, body, deadline: float) -> None:
+    """The child process: solve, send ("done", schedule) or ("error", exception), end."""
+    global _CHANNEL, _TOP
+    import dataclasses
+    import sys
+
+    os.setpgrp()  # a terminal's Ctrl-C reaches the parent only; the parent ends this process
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    threading.Thread(target=_lifeline, args=(lifeline,), name="uamopt-lifeline", daemon=True).start()
+    _CHANNEL, _TOP = channel, id(problem)
+    try:
+        left = max(0.05, deadline - time.monotonic())
+        schedule = body(problem, dataclasses.replace(profile, time_limit_s=left), extra)
+        message: tuple = ("done", schedule)
+    except BaseException as exc:  # noqa: BLE001 - every outcome goes to the parent, which raises it
+        message = ("error", exc)
+    try:
+        pickle.dumps(message)
+    except Exception:  # noqa: BLE001 - an exception of a library that does not pickle: its words
+        failure = message[1]
+        message = ("error", UamoptError(f"{type(failure).__name__}: {failure}", f"solver {profile.name or profile.solver}",
+                                        "rerun with isolated = false in the profile to see the traceback"))
+    _send(message)
+    sys.stdout.flush()
+    sys.stderr.flush()
+    os._exit(0)
+
+
+# --- the parent's side ----------------------------------------------------------------------------
+
+_CONTEXT: list = []
+
+
+def _context():
+    """The forkserver context, its preload set once (the server starts on first use)."""
+    if not _CONTEXT:
+        ctx = mp.get_context("forkserver")
+        ctx.set_forkserver_preload(PRELOAD)
+        _CONTEXT.append(ctx)
+    return _CONTEXT[0]
+
+
+def warm() -> None:
+    """Start the forkserver now (it imports the solver libraries in the background), so that the
+    first watched solve does not wait for it. Harmless where it cannot start."""
+    if "forkserver" in mp.get_all_start_methods() and not mp.current_process().daemon:
+        try:
+            from multiprocessing import forkserver
+
+            _context()
+            forkserver.ensure_running()
+        except Exception:  # noqa: BLE001 - the solve will say why, or run in this process
+            pass
+
+
+def why_not_isolated(profile: SolverProfile, extra) -> str | None:
+    """Why a solve runs in this process (None: it runs in a watched child)."""
+    if profile.solver not in WATCHED:
+        return "not watched: a heuristic that keeps time between its own steps"
+    if not profile.isolated:
+        return "isolated = false in the profile: the solve ran in this process, its time limit unguarded"
+    if "forkserver" not in mp.get_all_start_methods():
+        return "this platform has no forkserver: the solve ran in this process, its time limit unguarded"
+    if mp.current_process().daemon:
+        return "inside a daemonic process (a Dask worker?): the solve ran in it, its time limit unguarded"
+    if extra is not None:
+        if getattr(extra, "__module__", None) == "__main__":
+            return ("the extra= callback lives in the main script, which a child process does not import: the solve "
+                    "ran in this process, its time limit unguarded; define it in a module to keep it")
+        try:
+            pickle.dumps(extra)
+        except Exception:  # noqa: BLE001 - a lambda or a closure
+            return ("the extra= callback cannot be pickled (a lambda or closure): the solve ran in this process, "
+                    "its time limit unguarded; pass a module-level function to keep it")
+    return None
+
+
+@contextmanager
+def _main_not_reimported() -> Iterator[None]:
+    """Start a child without it importing this process's ``__main__`` again. multiprocessing's
+    forkserver (and spawn) children re-run the main script unless it is guarded by
+    ``if __name__ == "__main__":``; a researcher's script calling ``ua.solve`` at top level would run
+    again in every child. Nothing the child needs is in ``__main__`` (its target and arguments are
+    uamopt's own, or a callback checked by :func:`why_not_isolated`), so the main module's file and
+    spec are hidden while the child's preparation data is taken."""
+    import sys
+
+    main = sys.modules.get("__main__")
+    if main is None:
+        yield
+        return
+    saved: dict[str, Any] = {key: main.__dict__[key] for key in ("__file__", "__spec__") if key in main.__dict__}
+    try:
+        main.__dict__.pop("__file__", None)
+        main.__dict__["__spec__"] = None
+        yield
+    finally:
+        main.__dict__.pop("__spec__", None)
+        main.__dict__.update(saved)
+
+
+def run(problem: SchedulingProblem, profile: SolverProfile, extra, body) -> Schedule:
+    """``body(problem, profile, extra)`` in a watched child process (module docstring), or in this
+    process where that cannot be (the reason in ``extras["watchdog"]`` for a watched solver)."""
+    why = why_not_isolated(profile, extra)
+    if why is not None:
+        schedule = body(problem, profile, extra)
+        if profile.solver in WATCHED:
+            schedule.extras.setdefault("watchdog", why)
+        return schedule
+    return _run_child(problem, profile, extra, body)
+
+
+def _run_child(problem, profile, extra, body) -> Schedule:
+    import dataclasses
+
+    ctx = _context()
+    t0 = time.monotonic()
+    limit = float(profile.time_limit_s)
+    deadline, end = t0 + limit, t0 + kill_at(limit)
+    receive, channel = ctx.Pipe(duplex=False)
+    keep, lifeline = ctx.Pipe(duplex=False)  # the child's lifeline: its recv ends when `keep` closes
+    child = ctx.Process(target=_child, args=(channel, keep, problem, profile, extra, body, deadline),
+                        name=f"uamopt-{profile.solver}", daemon=True)
+    incumbents: list[tuple[np.ndarray, np.ndarray, str]] = []
+    bound: tuple[float, str] | None = None
+    answer: tuple | None = None
+    try:
+        with _main_not_reimported():
+            child.start()
+        channel.close()
+        keep.close()
+        while answer is None:
+            wait = end - time.monotonic()
+            if wait <= 0:
+                break
+            if not receive.poll(min(wait, 1.0)):
+                continue
+            try:
+                message = receive.recv()
+            except (EOFError, OSError):  # the child ended without its answer
+                break
+            if message[0] == "incumbent":
+                incumbents.append(message[1:])
+            elif message[0] == "bound":
+                if bound is None or message[1] > bound[0]:
+                    bound = (message[1], message[2])
+            else:
+                answer = message
+    finally:
+        if child.pid is not None:  # started
+            if child.is_alive():
+                child.kill()
+            child.join(5.0)
+        receive.close()
+        lifeline.close()
+    seconds = time.monotonic() - t0
+    if answer is not None:
+        if answer[0] == "error":
+            raise answer[1]
+        schedule = answer[1]
+        return dataclasses.replace(schedule, solve_seconds=seconds, extras={**schedule.extras, "watchdog": "child process"})
+    if time.monotonic() < end and child.exitcode not in (None, 0):  # died early: not a time limit
+        how = f"signal {-child.exitcode}" if child.exitcode < 0 else f"exit code {child.exitcode}"
+        hint = " (SIGKILL: often the machine's memory ran out)" if child.exitcode == -signal.SIGKILL else ""
+        raise UamoptError(f"the solver's process ended without an answer, by {how}{hint}",
+                          f"solver {profile.name or profile.solver}", "rerun with isolated = false in the profile to see why")
+    return _after_kill(problem, profile, incumbents, bound, seconds)
+
+
+def _after_kill(problem, profile, incumbents, bound, seconds) -> Schedule:
+    """The answer of a child ended at its deadline: its best reported schedule that the model
+    accepts (else every flight cancelled, where that is allowed), the best reported bound (else
+    :func:`separable_bound`), status ``time_limit``."""
+    from uamopt.schedule.model import evaluate, make_schedule, violations
+    from uamopt.solvers.warmstart import no_schedule
+
+    n = problem.n_flights
+    best = None
+    for operated, delay, source in incumbents:
+        if len(operated) != n or violations(problem, operated, delay):
+            continue
+        value = evaluate(problem, operated, delay)
+        if best is None or value < best[0]:
+            best = (value, operated, delay, source)
+    name = profile.name or profile.solver
+    if best is None:
+        none = np.zeros(n, dtype=bool)
+        if violations(problem, none, np.zeros(n)):
+            raise no_schedule(problem, name, f"the solver reported no schedule before it was ended at its "
+                              f"time limit ({seconds:.1f} s)")
+        best = (evaluate(problem, none, np.zeros(n)), none, np.zeros(n), "none reported: every flight cancelled")
+    value, source = separable_bound(problem), "the separable bound (every flight at its own best choice)"
+    if bound is not None and bound[0] > value:
+        value, source = bound
+    extras = {"termination": "ended at the time limit by the watchdog",
+              "watchdog": f"the child process did not answer by {kill_at(profile.time_limit_s):.1f} s "
+                          f"(limit {profile.time_limit_s:g} s) and was ended; {len(incumbents)} schedule(s) reported",
+              "incumbent": best[3], "bound_source": source}
+    return make_schedule(problem, profile.solver, "time_limit", best[1], best[2], bound=float(min(value, best[0])),
+                         solve_seconds=seconds, seed=profile.seed, extras=extras)
+
+
+def separable_bound(problem: SchedulingProblem) -> float:
+    """A lower bound on every objective kind, valid for continuous delays: each flight at its own
+    cheapest choice (cancelled, unless it must operate, or operated at its best delay in [0, U_f]),
+    every pair, turnaround and precedence row dropped. Weak where the city is over capacity, but
+    finite and at hand at once."""
+    o = problem.objective
+    upper = np.asarray(problem.delay_upper_s, dtype=float)
+    # an operated flight's cost is convex piecewise linear in d: least at 0, its target or U_f
+    candidates = [np.zeros_like(upper), upper]
+    if o.per_flight_terms:
+        candidates.append(np.clip(np.asarray(o.terms[0], dtype=float), 0.0, upper))
+    cost = np.min([o.delay_cost(d) for d in candidates], axis=0) - o.per_flight
+    pinned = np.asarray(problem.must_operate, dtype=bool)
+    return float(np.sum(np.where(pinned, cost, np.minimum(cost, 0.0))))
