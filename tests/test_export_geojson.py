@@ -13,6 +13,7 @@ import shutil
 import numpy as np
 import pytest
 import shapely
+import shapely.geometry
 from georef import hand_lonlat as _hand_lonlat
 
 from uamopt.cli import main
@@ -47,6 +48,46 @@ def test_files_read_back_inside_the_city(exported):
     np.testing.assert_allclose(coords[:, 0], lon, atol=5e-6)
     np.testing.assert_allclose(coords[:, 1], lat, atol=5e-6)
     np.testing.assert_allclose(coords[:, 2], wp[:, 2], atol=0.01)
+
+
+def _positions(coordinates):
+    """Every position of a GeoJSON geometry's (nested) ``coordinates``: the innermost lists."""
+    if coordinates and all(isinstance(c, int | float) for c in coordinates):
+        yield coordinates
+    else:
+        for c in coordinates:
+            yield from _positions(c)
+
+
+def _geometries(geometry: dict):
+    """A geometry and, for a GeometryCollection, its members."""
+    yield geometry
+    for member in geometry.get("geometries", []):
+        yield from _geometries(member)
+
+
+def test_every_geojson_file_reads_in_shapely_and_geopandas(exported):
+    """Every *.geojson the export writes (found by name, so a new one is covered): RFC 7946
+    positions of two or three elements, every feature's geometry read by Shapely and valid, the
+    file read by GeoPandas (pyogrio) with one row per feature and the same coordinates."""
+    paths = sorted(exported.glob("*.geojson"))
+    assert {"tracks.geojson", "vertiports.geojson", "unsafe.geojson"} <= {p.name for p in paths}
+    for path in paths:
+        doc = json.loads(path.read_text(encoding="utf-8"))
+        assert doc["type"] == "FeatureCollection" and len(doc["features"]) > 0, path.name
+        shapes = []
+        for feature in doc["features"]:
+            positions = [q for g in _geometries(feature["geometry"]) for q in _positions(g.get("coordinates", []))]
+            assert positions and all(len(q) in (2, 3) for q in positions), (path.name, feature["properties"])
+            geometry = shapely.geometry.shape(feature["geometry"])  # raises on 4-element positions
+            assert geometry.is_valid and not geometry.is_empty, (path.name, feature["properties"])
+            assert shapely.get_num_coordinates(geometry) == len(positions)
+            shapes.append(geometry)
+        frame = gpd.read_file(path, engine="pyogrio")
+        assert len(frame) == len(shapes) and frame.is_valid.all(), path.name
+        for mine, theirs in zip(shapes, frame.geometry, strict=True):
+            np.testing.assert_allclose(shapely.get_coordinates(theirs, include_z=mine.has_z),
+                                       shapely.get_coordinates(mine, include_z=mine.has_z), rtol=0, atol=1e-9)
 
 
 def test_vertiports_where_table_b3_puts_them(exported):

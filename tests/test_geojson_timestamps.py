@@ -1,4 +1,6 @@
-"""``uamopt export geojson``: the time of every vertex of tracks.geojson (trip layers, issue 20).
+"""``uamopt export geojson``: the time of every vertex of an operated flight (trip layers, issue 20):
+``timestamps`` in tracks.geojson (RFC 7946 positions, three elements) and the 4th coordinate of
+trips.kepler.json (kepler.gl's trip layer, operated flights only).
 
 Expected times are computed here from flights.json (waypoints, speed_mps, vertical_rate_mps) and
 schedule.csv (departure_s, arrival_s) with plain float arithmetic, not with uamopt's functions.
@@ -20,15 +22,12 @@ from uamopt.cli import main
 
 gpd = pytest.importorskip("geopandas")
 
-# GDAL reads [lon, lat, z, t] and says it drops t: expected, the timestamps property carries it
-pytestmark = pytest.mark.filterwarnings("ignore:.*too many members in array:RuntimeWarning")
-
 ANCHOR_UTC = "2026-01-01T00:00:00Z"
 ANCHOR_UNIX = datetime(2026, 1, 1, tzinfo=UTC).timestamp()
 OLD_PROPERTIES = {"id", "aircraft", "route", "origin", "destination", "operated", "departure_s", "arrival_s",
                   "speed_mps", "length_m"}  # what tracks.geojson wrote before the times
 TOL_S = 1e-6
-UNIX_TOL_S = 5e-4 + 1e-6  # the 4th coordinate is rounded to the millisecond (kepler.gl reads ≤ 3 decimals)
+UNIX_TOL_S = 5e-4 + 1e-6  # trips.kepler.json's 4th coordinate is rounded to the millisecond (kepler.gl reads ≤ 3 decimals)
 KEPLER_UNIX_SECONDS = re.compile(r"\d{9,10}(\.\d{1,3})?")  # type-analyzer's 'x' time format, used by kepler.gl
 
 
@@ -48,10 +47,11 @@ def _rows(folder) -> dict[str, dict]:
 
 
 def _export(folder):
+    """(tracks.geojson, trips.kepler.json, flights by id, schedule.csv rows by flight, tracks.geojson in GeoPandas)."""
     assert main(["export", "geojson", str(folder)]) == 0
-    doc = json.loads((folder / "tracks.geojson").read_text(encoding="utf-8"))
+    doc, trips = (json.loads((folder / name).read_text(encoding="utf-8")) for name in ("tracks.geojson", "trips.kepler.json"))
     flights = {f["id"]: f for f in json.loads((folder / "flights.json").read_text(encoding="utf-8"))["flights"]}
-    return doc, flights, _rows(folder), gpd.read_file(folder / "tracks.geojson").set_index("id")
+    return doc, trips, flights, _rows(folder), gpd.read_file(folder / "tracks.geojson", engine="pyogrio").set_index("id")
 
 
 def _segment_seconds(flight: dict) -> list[float]:
@@ -94,9 +94,17 @@ def vertical(root, tmp_path_factory):
     return _export(folder)
 
 
-def _check_operated(doc, flights, rows, frame) -> int:
-    """Every operated flight's vertex times; returns how many flights were checked."""
-    assert doc["uamopt"]["time_origin_utc"] == ANCHOR_UTC and doc["uamopt"]["time_origin_unix_s"] == ANCHOR_UNIX
+def _check_operated(doc, trips, flights, rows, frame) -> int:
+    """Every operated flight's vertex times, in tracks.geojson and trips.kepler.json; returns how
+    many flights were checked."""
+    for collection in (doc, trips):
+        assert collection["uamopt"]["time_origin_utc"] == ANCHOR_UTC
+        assert collection["uamopt"]["time_origin_unix_s"] == ANCHOR_UNIX
+    assert all(len(c) == 3 for f in doc["features"] for c in f["geometry"]["coordinates"])  # RFC 7946, every flight
+    operated = [r["flight"] for r in rows.values() if r["operated"] == "1"]
+    trip = {f["properties"]["id"]: f for f in trips["features"]}
+    assert trips["type"] == "FeatureCollection" and len(trips["features"]) == len(trip)
+    assert sorted(trip) == sorted(operated)  # the operated flights only: kepler.gl wants 4 elements everywhere
     checked = 0
     for feature in doc["features"]:
         p = feature["properties"]
@@ -104,6 +112,10 @@ def _check_operated(doc, flights, rows, frame) -> int:
         if row["operated"] != "1":
             continue
         coords = feature["geometry"]["coordinates"]
+        kepler = trip[p["id"]]
+        assert kepler["type"] == "Feature" and kepler["geometry"]["type"] == "LineString"
+        assert kepler["properties"] == p  # the same properties, timestamps included
+        trip_coords = kepler["geometry"]["coordinates"]
         flight = flights[p["id"]]
         expected = _expected_times(flight, float(row["departure_s"]))
         stamps = p["timestamps"]
@@ -113,38 +125,40 @@ def _check_operated(doc, flights, rows, frame) -> int:
         assert stamps[0] == pytest.approx(float(row["departure_s"]), abs=TOL_S) == p["departure_s"]
         assert stamps[-1] == pytest.approx(float(row["arrival_s"]), abs=TOL_S)
         assert all(b >= a for a, b in itertools.pairwise(stamps))
-        assert all(len(c) == 4 for c in coords)
-        unix = [c[3] for c in coords]
+        assert all(len(c) == 3 for c in coords) and all(len(c) == 4 for c in trip_coords)
+        assert [c[:3] for c in trip_coords] == coords  # the same positions, exactly
+        unix = [c[3] for c in trip_coords]
         np.testing.assert_allclose(np.array(unix) - ANCHOR_UNIX, stamps, rtol=0, atol=UNIX_TOL_S)
         assert all(b >= a for a, b in itertools.pairwise(unix))
         assert all(KEPLER_UNIX_SECONDS.fullmatch(json.dumps(t)) for t in unix)  # as written in the file
-        # GeoPandas: the same flight, z kept, the 4th coordinate dropped, the times as a list property
+        # GeoPandas: the same flight with z, the times as a list property
         geometry = frame.geometry[p["id"]]
         assert geometry.has_z and len(geometry.coords) == len(coords)
-        np.testing.assert_allclose(np.array(geometry.coords), np.array(coords)[:, :3], rtol=0, atol=1e-9)
+        np.testing.assert_allclose(np.array(geometry.coords), np.array(coords), rtol=0, atol=1e-9)
         np.testing.assert_allclose(np.asarray(frame.loc[p["id"], "timestamps"], float), stamps, rtol=0, atol=0)
         checked += 1
     return checked
 
 
 def test_operated_flights_carry_their_vertex_times(planned):
-    doc, flights, rows, frame, _ = planned
-    assert _check_operated(doc, flights, rows, frame) == 11
+    doc, trips, flights, rows, frame, _ = planned
+    assert _check_operated(doc, trips, flights, rows, frame) == 11
     assert max(len(f["waypoints"]) for f in flights.values()) > 10  # the cumulative sums are over many segments
 
 
 def test_cancelled_flight_is_written_as_before(planned):
-    doc, _, _, frame, cancelled = planned
+    doc, trips, _, _, frame, cancelled = planned
     feature = next(f for f in doc["features"] if f["properties"]["id"] == cancelled)
     p = feature["properties"]
     assert set(p) == OLD_PROPERTIES and p["operated"] is False and p["departure_s"] is None is p["arrival_s"]
     assert all(len(c) == 3 for c in feature["geometry"]["coordinates"])
     assert frame.loc[cancelled, "timestamps"] is None and not bool(frame.loc[cancelled, "operated"])
+    assert cancelled not in {f["properties"]["id"] for f in trips["features"]}  # no times: not a trip
 
 
 def test_vertical_phases_at_their_rate(vertical):
-    doc, flights, rows, frame = vertical
-    assert _check_operated(doc, flights, rows, frame) == 12
+    doc, trips, flights, rows, frame = vertical
+    assert _check_operated(doc, trips, flights, rows, frame) == 12
     for feature in doc["features"]:
         p = feature["properties"]
         flight = flights[p["id"]]

@@ -166,3 +166,96 @@ def test_bench_scheduler_flag_runs_the_windows_profile_on_a_started_cluster(tmp_
     lines = refused.stderr.strip().splitlines()
     assert refused.returncode == 2 and len(lines) == 1 and "--scheduler is for the windows solver" in lines[0]
     assert not (tmp_path / "nothing").exists()
+
+
+def _quick():
+    return {"done": True}
+
+
+def _slow():
+    import time
+
+    time.sleep(120)
+
+
+def _failing():
+    raise ValueError("a window's own failure")
+
+
+def test_collect_keeps_what_finished_and_names_what_was_lost():
+    """A window still running at the deadline and one whose task failed are lost, each with its
+    reason; the finished one is kept (a real LocalCluster, real tasks)."""
+    import time
+
+    from uamopt.cluster import connect
+    from uamopt.solvers.windows import collect
+
+    client, cluster = connect(None, 2, 3)
+    try:
+        futures = [client.submit(_quick, pure=False), client.submit(_slow, pure=False), client.submit(_failing, pure=False)]
+        results, lost = collect(client, futures, time.perf_counter() + 5.0)
+    finally:
+        client.close()
+        cluster.close()
+    assert results[0] == {"done": True} and results[1] is None and results[2] is None
+    assert lost[1] == "not done by the deadline" and "error" in lost[2] and 0 not in lost
+
+
+def test_collect_returns_when_the_scheduler_dies(tmp_path):
+    """The scheduler killed while its tasks run: every window is lost with a reason, and collect
+    returns by its deadline instead of waiting on a cluster that is gone."""
+    import json
+    import subprocess
+    import sys
+    import time
+    from pathlib import Path
+
+    from distributed import Client
+
+    from uamopt.solvers.windows import collect
+
+    dask = Path(sys.executable).parent / "dask"
+    file = tmp_path / "scheduler.json"
+    quiet = {"stdout": subprocess.DEVNULL, "stderr": subprocess.DEVNULL, "cwd": tmp_path}
+    scheduler = subprocess.Popen([str(dask), "scheduler", "--host", "127.0.0.1", "--port", "0", "--no-dashboard",
+                                  "--scheduler-file", str(file)], **quiet)
+    worker = None
+    try:
+        for _ in range(600):
+            try:
+                address = json.loads(file.read_text())["address"]
+                break
+            except (OSError, ValueError, KeyError):
+                time.sleep(0.1)
+        worker = subprocess.Popen([str(dask), "worker", address, "--nthreads", "1", "--no-dashboard", "--host",
+                                   "127.0.0.1"], **quiet)
+        client = Client(address, timeout=30)
+        client.wait_for_workers(1, timeout=120)
+        futures = [client.submit(_slow, pure=False) for _ in range(2)]
+        time.sleep(1.0)
+        scheduler.kill()
+        results, lost = collect(client, futures, time.perf_counter() + 5.0)
+        client.close(timeout=5)
+    finally:
+        for p in (scheduler, worker):
+            if p is not None:
+                p.kill()
+                p.wait(timeout=30)
+    assert results == [None, None] and sorted(lost) == [0, 1]
+
+
+def test_windows_lost_at_the_deadline_are_replaced_and_the_bound_stays_valid(day):
+    """Windows given far more time than the solve has (window_time_limit_s 600 s, limit 4 s): those not
+    done by the deadline are replaced by the warm start on their flights; the schedule is feasible,
+    the bound (their relaxations' separable bounds in the sum) stays below the proved optimum, and
+    every window is either finished or named as lost."""
+    problem, best = day
+    schedule = solve(problem, SolverProfile("windows", time_limit_s=4.0, threads=1,
+                                            options={"window_flights": 40, "window_time_limit_s": 600.0, "workers": 1}))
+    data = model_data(problem)
+    assert broken(data, schedule.operated, schedule.delay_s) == []
+    assert schedule.bound is not None and schedule.bound <= best + OBJ_TOL
+    lost = schedule.extras["windows_lost"]
+    assert all(why == "not done by the deadline" for why in lost.values())
+    assert set(lost) <= set(range(schedule.extras["windows"]))
+    assert all(b is not None for b in schedule.extras["window_bounds"])  # a lost window's separable bound too

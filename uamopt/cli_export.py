@@ -2,7 +2,7 @@
 
     uamopt export bluesky DIR [--dt S] [--bank DEG] [--trajectory designed|waypoints] [--zone RPZ,HPZ]
                               [--budget EH,EV]                                       # DIR/bluesky.scn
-    uamopt export geojson DIR [--risk risk.npz | --scenario FILE [--set K=V ...]]        # DIR/*.geojson
+    uamopt export geojson DIR [--risk risk.npz | --scenario FILE [--set K=V ...]]  # DIR/*.geojson, trips.kepler.json
     uamopt replay DIR [--dt S] [--bank DEG] [--trajectory designed|waypoints] [--zone RPZ,HPZ] [--budget EH,EV]
                       [--window T0,T1]
 
@@ -86,7 +86,7 @@ def cmd_export_geojson(args) -> int:
         raise UamoptError("--risk and --scenario both given", "command line", "give one source of the unsafe airspace")
     with output_lock(args.dir, "DIR"):
         paths = export_geojson(args.dir, risk=args.risk, scenario=args.scenario, overrides=args.set)
-    print("GeoJSON (WGS 84): " + ", ".join(p.name for p in paths) + f" -> {Path(args.dir)}")
+    print("GeoJSON and kepler.gl trips (WGS 84): " + ", ".join(p.name for p in paths) + f" -> {Path(args.dir)}")
     return 0
 
 
@@ -116,14 +116,15 @@ def cmd_replay(args) -> int:
 
 def add_export_commands(sub) -> None:
     """Add ``export bluesky``, ``export geojson`` and ``replay`` to the subparsers ``sub`` of ``uamopt``."""
-    text = "export a schedule folder: bluesky (bluesky.scn) or geojson (tracks, vertiports, unsafe airspace)"
+    text = "export a schedule folder: bluesky (bluesky.scn) or geojson (tracks, vertiports, unsafe airspace, kepler.gl trips)"
     export = sub.add_parser("export", help=text, description=text)
     kinds = export.add_subparsers(dest="kind", required=True, parser_class=type(export))
     text = "write DIR/bluesky.scn: the operated flights as a BlueSky scenario"
     bluesky = kinds.add_parser("bluesky", help=text, description=text)
     _simulation_options(bluesky)
     bluesky.set_defaults(func=cmd_export_bluesky)
-    text = "write DIR/tracks.geojson, vertiports.geojson, unsafe.geojson in WGS 84"
+    text = ("write DIR/tracks.geojson, vertiports.geojson, unsafe.geojson (RFC 7946) and trips.kepler.json "
+            "(kepler.gl's trip layer: the operated flights, positions [lon, lat, z, Unix time]) in WGS 84")
     geojson = kinds.add_parser("geojson", help=text, description=text)
     geojson.add_argument("dir", help="a schedule folder written by uamopt schedule")
     geojson.add_argument("--risk", help="risk.npz of the same scenario (default: recompute from the recorded scenario)")

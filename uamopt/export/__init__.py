@@ -1,7 +1,7 @@
 """Exports of a schedule folder for other tools (docs/interfaces.md, docs/export.md).
 
     export_bluesky("out/sched")   # out/sched/bluesky.scn: a BlueSky scenario of the operated flights
-    export_geojson("out/sched")   # tracks.geojson, vertiports.geojson, unsafe.geojson in WGS 84
+    export_geojson("out/sched")   # tracks, vertiports, unsafe .geojson in WGS 84; trips.kepler.json
     flyable_trajectory(waypoints, 25.0, 45.0)   # what the BlueSky export commands for one track
 
 The georeference of the local frame is :mod:`uamopt.export.frame`; the replay in BlueSky is

@@ -1,24 +1,30 @@
 """``uamopt export geojson DIR``: tracks, vertiports and unsafe airspace for GIS tools.
 
 Writes three RFC 7946 files into the schedule folder DIR, in WGS 84 (longitude, latitude[, z]),
-through the folder's :class:`~uamopt.export.frame.LocalFrame`; QGIS, kepler.gl and GeoPandas
-read them as they are:
+through the folder's :class:`~uamopt.export.frame.LocalFrame`; QGIS, GeoPandas, Shapely and
+kepler.gl read them as they are (every position has two or three elements):
 
-- ``tracks.geojson``: one LineString per flight with z (m above the ground datum) at every
-  waypoint; properties id, aircraft, route, origin, destination, operated, departure_s,
-  arrival_s (null when cancelled), speed_mps, length_m. An operated flight's vertices carry their
-  time too, for trip layers (kepler.gl, QGIS's temporal controller): a 4th coordinate, Unix time
-  in seconds rounded to the millisecond ([lon, lat, z, t], kepler.gl's trip-layer form), and the
-  properties ``timestamps`` (s on the schedule's clock, the clock of departure_s, one per vertex:
-  departure + :func:`~uamopt.schedule.flights.waypoint_times_s`) and ``time_origin_utc``. The
-  schedule records no calendar date, so clock 0 s is the fixed :data:`TIME_ORIGIN_UTC`
-  (t = :data:`TIME_ORIGIN_UNIX_S` + clock), also in the collection's ``uamopt`` member. A
-  cancelled flight keeps [lon, lat, z] and has neither property.
+- ``tracks.geojson``: one LineString per flight, positions [lon, lat, z] with z (m above the
+  ground datum) at every waypoint; properties id, aircraft, route, origin, destination, operated,
+  departure_s, arrival_s (null when cancelled), speed_mps, length_m. An operated flight also
+  carries the time of its vertices in the properties ``timestamps`` (s on the schedule's clock,
+  the clock of departure_s, one per vertex: departure + :func:`~uamopt.schedule.flights.waypoint_times_s`)
+  and ``time_origin_utc``; a cancelled flight has neither. The schedule records no calendar date,
+  so clock 0 s is the fixed :data:`TIME_ORIGIN_UTC` (Unix time :data:`TIME_ORIGIN_UNIX_S` + clock),
+  also in the collection's ``uamopt`` member.
 - ``vertiports.geojson``: one Point per vertiport named in the flights (a track's first point is
   its origin, its last point its destination).
 - ``unsafe.geojson``: one (Multi)Polygon per altitude layer, the union of that layer's unsafe
   cells (Eq. 9: risk above R_0, obstacle or no-fly); properties layer, z_bottom_m, z_top_m,
   z_centre_m, in_band (Eq. 14; null when read from a risk.npz), unsafe_cells, obstacle_cells.
+
+It also writes ``trips.kepler.json`` for trip layers: the operated flights only, in kepler.gl's trip-layer
+convention, a FeatureCollection of LineStrings whose positions have four elements
+[lon, lat, z, t], t the Unix time in seconds rounded to the millisecond (kepler.gl's time
+detection takes at most 3 decimals), with the same properties as in tracks.geojson and the time
+origin in the collection's ``uamopt`` member. Four-element positions are not RFC 7946 (positions
+SHOULD NOT have more than three elements, and Shapely refuses them), which is why that file is a
+``.json`` and not a ``.geojson``; kepler.gl loads it by its content.
 
 The unsafe airspace needs the risk field. By default it is recomputed from the scenario the folder
 records (summary.json ``scenario``: file and overrides); ``risk=`` takes a ``risk.npz`` written by
@@ -53,7 +59,7 @@ METRE_DIGITS = 2
 #: the scenario and the frame carry none), so the trip layers' Unix times start at a fixed day
 TIME_ORIGIN_UTC = "2026-01-01T00:00:00Z"
 TIME_ORIGIN_UNIX_S = int(datetime(2026, 1, 1, tzinfo=UTC).timestamp())  # 1767225600
-#: decimals of the 4th coordinate (ms): kepler.gl recognises Unix seconds with at most 3 decimals
+#: decimals of trips.kepler.json's 4th coordinate (ms): kepler.gl recognises Unix seconds with at most 3 decimals
 UNIX_DIGITS = 3
 
 
@@ -76,9 +82,9 @@ def _lonlat(frame, xy: np.ndarray) -> np.ndarray:
     return np.column_stack([np.round(lon, DEGREE_DIGITS), np.round(lat, DEGREE_DIGITS)])
 
 
-def track_features(folder: ScheduleFolder) -> list[dict]:
-    """One LineString Z feature per flight of the folder; an operated flight's with the time of
-    every vertex (4th coordinate, Unix s; ``timestamps``, clock s)."""
+def _tracks(folder: ScheduleFolder) -> list[tuple[np.ndarray, dict, np.ndarray | None]]:
+    """Per flight of the folder: its [lon, lat, z] positions, its properties and, when it is
+    operated, the clock time of every vertex (s; None when cancelled)."""
     times = {o.flight.id: o for o in folder.operated}
     out = []
     for f in folder.flights.flights:
@@ -89,13 +95,30 @@ def track_features(folder: ScheduleFolder) -> list[dict]:
                       "destination": f.destination, "operated": o is not None,
                       "departure_s": o.departure_s if o else None, "arrival_s": o.arrival_s if o else None,
                       "speed_mps": f.speed_mps, "length_m": round(f.length_m, METRE_DIGITS)}
+        clock = None
         if o is not None:
             clock = vertex_times_s(o)
-            coords = np.column_stack([coords, np.round(TIME_ORIGIN_UNIX_S + clock, UNIX_DIGITS)])
             properties.update(timestamps=clock.tolist(), time_origin_utc=TIME_ORIGIN_UTC)
-        out.append({"type": "Feature", "geometry": {"type": "LineString", "coordinates": coords.tolist()},
-                    "properties": properties})
+        out.append((coords, properties, clock))
     return out
+
+
+def _line(coords: np.ndarray, properties: dict) -> dict:
+    return {"type": "Feature", "geometry": {"type": "LineString", "coordinates": coords.tolist()},
+            "properties": properties}
+
+
+def track_features(folder: ScheduleFolder) -> list[dict]:
+    """One LineString Z feature per flight of the folder, RFC 7946 positions [lon, lat, z]; an
+    operated flight's with the time of every vertex (``timestamps``, clock s)."""
+    return [_line(coords, properties) for coords, properties, _ in _tracks(folder)]
+
+
+def trip_features(folder: ScheduleFolder) -> list[dict]:
+    """kepler.gl's trip layer: one LineString per operated flight with positions [lon, lat, z, t],
+    t its Unix time in s rounded to the millisecond (not RFC 7946: four elements)."""
+    return [_line(np.column_stack([coords, np.round(TIME_ORIGIN_UNIX_S + clock, UNIX_DIGITS)]), properties)
+            for coords, properties, clock in _tracks(folder) if clock is not None]
 
 
 def vertiport_features(folder: ScheduleFolder) -> list[dict]:
@@ -165,7 +188,8 @@ def _unsafe_layers(folder: ScheduleFolder, risk: str | Path | None, scenario: st
 
 def export_geojson(path: str | Path, *, risk: str | Path | None = None, scenario: str | None = None,
                    overrides: list[str] | None = None) -> list[Path]:
-    """Write tracks.geojson, vertiports.geojson and unsafe.geojson into the schedule folder ``path``.
+    """Write tracks.geojson, vertiports.geojson, unsafe.geojson (RFC 7946) and trips.kepler.json
+    (kepler.gl's trip layer) into the schedule folder ``path``, all or nothing; returns their paths.
 
     Raises
     ------
@@ -177,8 +201,10 @@ def export_geojson(path: str | Path, *, risk: str | Path | None = None, scenario
     """
     folder = read_schedule_folder(path)
     layers = _unsafe_layers(folder, risk, scenario, overrides)  # before writing anything
-    files = {"tracks.geojson": track_features(folder), "vertiports.geojson": vertiport_features(folder),
-             "unsafe.geojson": unsafe_features(folder, *layers)}
-    extra = {"tracks.geojson": {"time_origin_utc": TIME_ORIGIN_UTC, "time_origin_unix_s": TIME_ORIGIN_UNIX_S}}
-    return write_texts(folder.path, {name: _collection(features, folder, name.removesuffix(".geojson"), extra.get(name))
-                                     for name, features in files.items()})
+    origin = {"time_origin_utc": TIME_ORIGIN_UTC, "time_origin_unix_s": TIME_ORIGIN_UNIX_S}
+    files = {"tracks.geojson": ("tracks", track_features(folder), origin),
+             "vertiports.geojson": ("vertiports", vertiport_features(folder), None),
+             "unsafe.geojson": ("unsafe", unsafe_features(folder, *layers), None),
+             "trips.kepler.json": ("trips", trip_features(folder), origin)}
+    return write_texts(folder.path, {name: _collection(features, folder, what, extra)
+                                     for name, (what, features, extra) in files.items()})

@@ -47,6 +47,47 @@ if TYPE_CHECKING:
 SHAPES = frozenset({"bounds", "must_operate", "precedence", "turnaround", "pairs"})
 OBJECTIVES = frozenset({"weighted"})
 WINDOWS_SHARE = 0.75  # of the time limit, for the windows (the rest: joining, mending, search)
+#: the windows' results are waited for until this share of the time limit: a window whose engine
+#: overran its own limit (HiGHS's presolve does not listen), or whose worker or scheduler died, is
+#: replaced by the warm start on its flights (:func:`stand_in`), so that the solve keeps its limit
+GATHER_SHARE = 0.85
+
+
+def collect(client, futures: list, deadline: float) -> tuple[list, dict[int, str]]:
+    """The windows' results in order, waited for until ``deadline`` (a ``time.perf_counter`` time),
+    and the windows lost: {index: why} (not done by then, failed, or the cluster gone)."""
+    from distributed import wait
+
+    results: list = [None] * len(futures)
+    lost: dict[int, str] = {}
+    try:
+        wait(futures, timeout=max(0.1, deadline - time.perf_counter()))
+    except Exception:  # noqa: BLE001 - TimeoutError: some not done; OSError & co: the cluster is gone
+        pass
+    for k, future in enumerate(futures):
+        try:
+            if future.status == "finished":
+                results[k] = future.result(timeout=5)
+                continue
+            lost[k] = "not done by the deadline" if future.status == "pending" else f"its task {future.status}"
+        except Exception as exc:  # noqa: BLE001 - a worker killed too often, the scheduler gone
+            lost[k] = f"{type(exc).__name__}: {exc}"[:200]
+        try:
+            future.cancel()
+        except Exception:  # noqa: BLE001 - the client is gone already
+            pass
+    return results, lost
+
+
+def stand_in(sub: SchedulingProblem, start, index: np.ndarray, why: str) -> dict:
+    """A lost window's result: the warm start restricted to its flights (the join mends it with the
+    rest), and the separable bound of its relaxed sub-problem (valid: the sum stays a bound)."""
+    from uamopt.solvers.watchdog import separable_bound
+
+    operated = start.operated[index] if start.found else None
+    delay = np.where(operated, start.delay_s[index], 0.0) if operated is not None else None
+    return {"bound": separable_bound(sub), "clique_rows": 0, "operated": operated, "delay_s": delay,
+            "objective": None, "rounds": 0, "seconds": 0.0, "proved": False, "at_limit": True, "lost": why}
 
 
 def window_problem(problem: SchedulingProblem, index: np.ndarray) -> SchedulingProblem:
@@ -139,11 +180,13 @@ def solve(problem: SchedulingProblem, profile: SolverProfile) -> Schedule:
         # Dask warned of a large graph)
         futures = client.map(solve_window, client.scatter(subs), [per_window] * len(subs),
                              [profile.seed] * len(subs), [options] * len(subs), pure=False)
-        results = client.gather(futures)
+        results, lost = collect(client, futures, t0 + GATHER_SHARE * profile.time_limit_s)
     finally:
         client.close()
         if cluster is not None:
             cluster.close()
+    for k, why in lost.items():  # the warm start on that window, and any valid bound of its relaxed sub-problem
+        results[k] = stand_in(subs[k], start, windows[k], why)
     bounds = [r["bound"] for r in results]
     bound = float(sum(bounds)) if all(b is not None for b in bounds) else None
     operated, delay = join(problem, list(zip(windows, results, strict=True)))
@@ -157,7 +200,13 @@ def solve(problem: SchedulingProblem, profile: SolverProfile) -> Schedule:
         improved += better
         if not better:
             break
-    assert not violations(problem, operated, delay), "the joined schedule breaks a row"
+    broken = violations(problem, operated, delay)
+    if broken:  # not expected (join mends every cross-window row): the warm start, and say so
+        if not start.found:
+            from uamopt.solvers.warmstart import no_schedule
+
+            raise no_schedule(problem, profile.name or "windows", f"the joined windows break a row ({broken[0]})")
+        operated, delay = start.decisions
     value = evaluate(problem, operated, delay)
     proved = bound is not None and value - bound <= 1e-9 * (1.0 + abs(value))
     extras = {"model": "continuous (bound: the sum of the windows' discovery bounds, cross-window rows dropped)",
@@ -168,6 +217,8 @@ def solve(problem: SchedulingProblem, profile: SolverProfile) -> Schedule:
               "windows_at_limit": int(sum(bool(r["at_limit"]) for r in results)),
               "windows_proved": int(sum(bool(r["proved"]) for r in results)),
               "window_seconds": [round(r["seconds"], 1) for r in results], "lns_passes": passes,
+              "windows_lost": {int(k): why for k, why in lost.items()},
+              "joined_schedule": f"broke a row ({broken[0]}): the warm start kept" if broken else "feasible",
               "lns_windows_improved": improved,
               "warm_start": f"{start.source} {start.objective:.6f}", "continuous_bound": bound,
               "continuous_bound_model": "sum over windows of discovery relaxations (cross-window rows dropped)"}
