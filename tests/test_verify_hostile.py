@@ -210,3 +210,19 @@ def test_a_schedule_of_millions_of_conflicting_pairs_stops_at_the_cap(tmp_path, 
     lines = capsys.readouterr().out.splitlines()
     assert sum(line.startswith("conflict: flights") for line in lines) == MAX_CONFLICTS
     assert any("the search stopped at 10,000 conflicting pairs" in line for line in lines)
+
+
+def test_a_folder_too_large_to_verify_is_refused_before_it_is_read(good, tmp_path, capsys):
+    """flights.json as large as this machine's memory (a sparse file: no disk is used, and nothing of
+    it is read): the verifier's estimate (4 bytes a byte of input) exceeds its limit (80 % of the
+    memory), so one line with both figures and exit code 2, before any parse."""
+    import os
+
+    folder = tmp_path / "huge"
+    shutil.copytree(good, folder)
+    memory = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    with open(folder / "flights.json", "r+b") as fh:
+        fh.truncate(memory)
+    assert main(["verify", str(folder)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "needs about" in err[0] and "more than the limit of" in err[0] and " GB" in err[0]
