@@ -246,7 +246,7 @@ def test_a_round_cut_short_doubles_the_cap_and_discovery_goes_on(busy_problem):
     small = reduced(busy_problem)
     data = model_data(busy_problem)
     state: dict = {}
-    found = discover(busy_problem, small, time.perf_counter() + 15.0, 1, 0, start=None, gap=0.005,
+    found = discover(busy_problem, small, time.perf_counter() + 90.0, 1, 0, start=None, gap=0.005,  # 15 s failed at load 13
                      round_s=1e-6, state=state)
     assert found.rounds[0].termination != "Optimal"  # cut short at once (HiGHS's shortest limit, 50 ms)
     assert state["round_s"] > 1e-6  # later rounds got longer ...
@@ -259,13 +259,19 @@ def test_a_round_cut_short_doubles_the_cap_and_discovery_goes_on(busy_problem):
 @pytest.mark.parametrize("objective", ["weighted", "lexicographic"])
 def test_paper_case_against_the_continuous_milp(paper_straight_plan, objective):
     """Weighted: proved optimal, the MILP's optimum. Lexicographic (no dominance caps: wide delay
-    ranges, 60 s are not enough to prove it): a bound below and a schedule above the MILP's optimum."""
+    ranges, 60 s are not enough to prove it): a bound below and a schedule above the MILP's optimum.
+    What holds at any stopping point is asserted always (each bound below the other's schedule); the
+    MILP's proof took more than 120 s at load 13 (the lexicographic case), so the comparisons with
+    its optimum are made when it has one."""
     scenario, _, _, flights = paper_straight_plan
     problem = build_problem(flights, scenario, objective=objective)
     found = solve(problem, SolverProfile("discovery", time_limit_s=60.0, threads=2))
     milp = solve(problem, SolverProfile("highs", time_limit_s=120.0, threads=2))
-    assert milp.status == "optimal"
     assert broken(model_data(problem), found.operated, found.delay_s) == []
+    assert found.bound <= milp.objective + OBJ_TOL and milp.bound <= found.objective + OBJ_TOL
+    if milp.status != "optimal":
+        assert objective == "lexicographic" and milp.status == "time_limit"  # the weighted case is proved in seconds
+        return
     assert found.bound <= milp.objective + OBJ_TOL <= found.objective + 2 * OBJ_TOL
     if objective == "weighted":
         assert found.status == "optimal"

@@ -76,7 +76,9 @@ def test_solve_by_name_uses_the_shipped_profile(paper_straight_plan, root):
     windows = windows_of(problem, shipped["options"]["window_s"])
     assert s.solver == "rolling" and exact.status == "optimal" and windows > 1
     assert s.extras["windows"] == windows and s.extras["inner"] == shipped["options"]["inner"]
-    assert s.extras["window_time_limit_s"] == pytest.approx(shipped["time_limit_s"] / windows) and s.seed == shipped["seed"]
+    # the watched child gets the limit less its own start (the forkserver's first start, seconds at load 8)
+    assert s.extras["window_time_limit_s"] == pytest.approx(shipped["time_limit_s"] / windows, rel=0.1)
+    assert s.extras["window_time_limit_s"] <= shipped["time_limit_s"] / windows and s.seed == shipped["seed"]
     # the options the file sets are also the solver's defaults (900 s, cpsat): what the loader read of them
     loaded = load_profile("rolling")
     assert (loaded.solver, loaded.time_limit_s, loaded.threads, loaded.seed, dict(loaded.options)) == (

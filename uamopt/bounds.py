@@ -32,6 +32,8 @@ INT64_MAX = 2**63 - 1
 MAX_COORD_M = 1e6  # |x|, |y|, |z| of the local frame, m (1,000 km: the verifier's range)
 MAX_TIME_S = 1e7  # times and durations of a schedule, s (about 116 days: the verifier's range)
 MAX_DIGITS = 4300  # Python's int-string conversion limit (sys.get_int_max_str_digits)
+MAX_WEIGHT = 1e6  # a weight of an objective (schedule.weights, ω6 and ω7): the scenario key's range
+GRID_TOL_M = 1e-6  # slack beyond the grid's top faces (x_max, y_max, z_max) for round-off, m: see outside_grid
 
 
 def shown(value, limit: int = 40) -> str:
@@ -122,6 +124,26 @@ def check_points(raw, what: str, where: str, fix: str, minimum: int = 2, error: 
         if bad:
             raise error(f"{rule}: point {n + 1} holds {shown(bad[0])}", where, fix)
     return np.array(raw, dtype=float)
+
+
+def outside_grid(points, extent):
+    """Per point of ``points`` ((n, 3), m), True where it lies outside the grid [0, x_max] × [0, y_max]
+    × [0, z_max] = ``extent``: the one rule of the flights and network readers, the pipeline's
+    airspace check and ``uamopt verify``, so that a track one accepts no other refuses.
+
+    The top faces get :data:`GRID_TOL_M` of slack (an extent of n whole cells, a track planned on
+    its face, carry round-off); the lower faces none: 0 is the origin of the local frame, exact in
+    floating point (a planned track is clipped to it), and the verifier holds every coordinate to
+    the frame, ≥ 0, whatever the grid.
+
+    >>> outside_grid([[0.0, 5.0, 1.0], [10.0 + 5e-7, 5.0, 1.0], [-5e-7, 5.0, 1.0]], (10.0, 10.0, 10.0)).tolist()
+    [False, False, True]
+    """
+    import numpy as np
+
+    pts = np.asarray(points, dtype=float).reshape(-1, 3)
+    top = np.asarray(extent, dtype=float) + GRID_TOL_M
+    return np.any((pts < 0.0) | (pts > top), axis=1)
 
 
 def read_json(path, what: str, source: str, fix: str):

@@ -94,14 +94,16 @@ def cmd_schedule(args) -> int:
 
     scenario = _load(args)
     profile = load_profile(args.solver)
-    if args.scheduler:  # the windows solver's tasks on a running Dask cluster
+    if args.scheduler is not None:  # the windows solver's tasks on a running Dask cluster
         import dataclasses
 
+        from uamopt.cluster import reach_scheduler
         from uamopt.errors import UamoptError
 
         if profile.solver != "windows":
             raise UamoptError(f"--scheduler is for the windows solver, not {profile.solver}", "--scheduler",
                               "use --solver windows, or drop --scheduler")
+        reach_scheduler(args.scheduler)  # a malformed address, or nobody there: one line before the network is planned
         profile = dataclasses.replace(profile, options={**profile.options, "scheduler": args.scheduler})
     solver_module(profile.solver)  # a solver of an extra not installed: its one line before any work
     problem, s, problems = schedule_folder(scenario, args.out, profile, args.flights, args.network, args.seed, args.set)
@@ -140,7 +142,10 @@ def cmd_view(args) -> int:
     path = view.save(out)
     frames = len(view.figure.frames)
     playback = f"{frames} frames, " if frames else "no playback, "
-    print(f"view: {playback}{path.stat().st_size / 1e6:.1f} MB, {time.perf_counter() - started:.1f} s -> {path}")
+    rejected = view.spec["layout"].get("meta", {}).get("uamopt", {}).get("rejected") or []
+    said = f"the verifier rejects {len(rejected)} flights (drawn red; uamopt verify lists why), " if rejected else ""
+    print(printable(f"view: {playback}{said}{path.stat().st_size / 1e6:.1f} MB, {time.perf_counter() - started:.1f} s "
+                    f"-> {path}"))
     return 0
 
 

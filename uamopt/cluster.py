@@ -5,6 +5,7 @@ loopback interface (processes, one thread each), or on a running cluster at a sc
 
 from __future__ import annotations
 
+import gc
 import logging
 import os
 import signal
@@ -30,6 +31,85 @@ def quiet_resource_tracker() -> None:
         sys.warnoptions.append(TRACKER_QUIET)
 
 
+#: the address schemes of a running Dask cluster (distributed's comm backends; "inproc" is within one process)
+SCHEMES = ("tcp", "tls", "ws", "wss", "ucx")
+
+
+def scheduler_address(scheduler: str) -> tuple[str, str, int]:
+    """``--scheduler`` as Dask takes it, ``(address, host, port)``: ``SCHEME://HOST:PORT`` with a
+    scheme of :data:`SCHEMES` (``HOST:PORT`` is tcp), a host and a port in 1-65535, nothing else
+    (no path, no spaces). Else one :class:`UamoptError` naming the option, before anything runs.
+
+    >>> scheduler_address("127.0.0.1:8786")
+    ('tcp://127.0.0.1:8786', '127.0.0.1', 8786)
+    """
+    from urllib.parse import urlsplit
+
+    from uamopt.bounds import shown
+
+    address = scheduler if "://" in scheduler else f"tcp://{scheduler}"
+    try:
+        parts = urlsplit(address)
+        host, port = parts.hostname, parts.port
+    except ValueError:  # a port that is no number or beyond 65535, an unclosed [IPv6
+        parts, host, port = None, None, None
+    well_formed = (parts is not None and parts.scheme in SCHEMES and f"{parts.scheme}://{parts.netloc}" == address
+                   and "@" not in parts.netloc and bool(host) and port is not None and 1 <= port <= 65535
+                   and all(c.isprintable() and not c.isspace() for c in str(host)))
+    if not well_formed:
+        raise UamoptError(f"{shown(scheduler)} is not the address of a Dask scheduler", "--scheduler",
+                          "give tcp://HOST:PORT as `dask scheduler` prints it, e.g. tcp://127.0.0.1:8786")
+    return address, str(host), int(port)
+
+
+def reach_scheduler(scheduler: str) -> str:
+    """The address of ``scheduler`` (:func:`scheduler_address`) once a Dask scheduler answers there
+    within :data:`CONNECT_TIMEOUT_S`: a TCP connection (refused at once where nobody listens) and,
+    for ``tcp://``, Dask's handshake (a server that accepts and stays silent held distributed's
+    ``Client`` forever: its handshake read has no timeout). Else one :class:`UamoptError`, so a
+    command says so before its work and no half-made Dask client is left behind."""
+    import socket
+
+    address, host, port = scheduler_address(scheduler)
+    try:
+        if not address.startswith("ucx://"):  # ucx is not TCP: the client's own connection says
+            socket.create_connection((host, port), timeout=CONNECT_TIMEOUT_S).close()
+        if address.startswith("tcp://"):  # tls and ws need the cluster's security settings: the client's
+            _handshake(address)
+    except OSError as exc:  # refused, unreachable, timed out (TimeoutError), an unknown host name
+        raise UamoptError(f"cannot reach the Dask scheduler at {scheduler} ({error_line(exc)})", "--scheduler",
+                          "start one with `dask scheduler`, check the address, or drop --scheduler") from None
+    return address
+
+
+def _handshake(address: str) -> None:
+    """Open a Dask comm to ``address`` and close it, all within :data:`CONNECT_TIMEOUT_S`, on a
+    loop of its own (a thread: the caller may run inside an event loop). Raises ``OSError``."""
+    import asyncio
+
+    from distributed.comm import connect as open_comm
+
+    async def probe() -> None:
+        comm = await asyncio.wait_for(open_comm(address, timeout=CONNECT_TIMEOUT_S), CONNECT_TIMEOUT_S)
+        await comm.close()
+
+    failure: list[BaseException] = []
+
+    def run() -> None:
+        try:
+            asyncio.run(probe())
+        except BaseException as exc:  # noqa: BLE001 - reported to the caller below
+            failure.append(exc)
+
+    thread = threading.Thread(target=run, name="uamopt-scheduler-probe", daemon=True)
+    thread.start()
+    thread.join(CONNECT_TIMEOUT_S + 2.0)
+    if thread.is_alive() or (failure and isinstance(failure[0], (asyncio.TimeoutError, TimeoutError))):
+        raise TimeoutError(f"no Dask handshake within {CONNECT_TIMEOUT_S:g} s: something else listens there")
+    if failure:
+        raise failure[0] if isinstance(failure[0], OSError) else OSError(error_line(failure[0]))
+
+
 def connect(scheduler: str | None, workers: int | None, tasks: int, scratch: str | None = None):
     """A Dask client: on the cluster at ``scheduler``, or on a new loopback LocalCluster whose
     scratch space and TMPDIR are ``scratch`` (default: Dask's, ``dask-scratch-space`` in TMPDIR).
@@ -41,13 +121,18 @@ def connect(scheduler: str | None, workers: int | None, tasks: int, scratch: str
     from distributed import Client, LocalCluster
 
     if scheduler:
-        address = scheduler if "://" in scheduler else f"tcp://{scheduler}"
+        address = reach_scheduler(scheduler)
         logging.getLogger("distributed").setLevel(logging.ERROR)
         try:
             return Client(address, timeout=CONNECT_TIMEOUT_S), None
-        except Exception as exc:  # noqa: BLE001 - OSError, TimeoutError, ValueError on a bad address
-            raise UamoptError(f"cannot reach the Dask scheduler at {scheduler} ({error_line(exc)})", "--scheduler",
-                              "start one with `dask scheduler`, check the address, or drop --scheduler") from None
+        except Exception as exc:  # noqa: BLE001 - OSError, TimeoutError: something listens there, not a scheduler
+            failure = error_line(exc)
+        # the half-made Client sits in a reference cycle; collected later, at an allocation inside the
+        # next Client's start, its __del__ waited for the loop lock that start held (a bench run hung
+        # there for the rest of its time limit): collect it here, where no lock is held
+        gc.collect()
+        raise UamoptError(f"cannot reach the Dask scheduler at {scheduler} ({failure})", "--scheduler",
+                          "start one with `dask scheduler`, check the address, or drop --scheduler")
     n = workers or max(1, min(os.cpu_count() or 1, tasks))
     quiet_resource_tracker()
     # Ctrl-C reaches every process of the terminal's group, and the workers printed tracebacks.

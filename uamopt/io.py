@@ -139,11 +139,27 @@ def load_network(path: str | Path) -> RouteNetwork:
 
 
 def load_flights(path: str | Path, scenario=None, grid=None, network=None) -> FlightSet:
-    """The :class:`~uamopt.schedule.flights.FlightSet` of ``flights.json`` (validated)."""
-    expect_path(path, "path", "load_flights")
+    """The :class:`~uamopt.schedule.flights.FlightSet` of ``flights.json`` (validated): ``scenario``
+    (a Scenario) fills in what the file does not give, ``grid`` (an AirspaceGrid) holds every waypoint
+    inside it, ``network`` (a RouteNetwork or route name -> waypoints) gives the tracks of flights
+    without waypoints (:func:`uamopt.schedule.flights_file.load_flights`)."""
+    from collections.abc import Mapping
 
+    from uamopt.checks import expect
+    from uamopt.grid import AirspaceGrid
+    from uamopt.scenario import Scenario
     from uamopt.schedule.flights_file import load_flights as load
 
+    expect_path(path, "path", "load_flights")
+    if scenario is not None:
+        expect(scenario, Scenario, "scenario", "load_flights")
+    if grid is not None:
+        expect(grid, AirspaceGrid, "grid", "load_flights")
+    if callable(getattr(network, "waypoints", None)):  # a RouteNetwork
+        network = network.waypoints()
+    if network is not None and not isinstance(network, Mapping):
+        raise TypeError("load_flights(): network must be a RouteNetwork or a mapping route name -> (n, 3) waypoints, "
+                        f"got {type(network).__name__}")
     return load(_file(path, "flights.json"), scenario, grid, network)
 
 

@@ -51,6 +51,8 @@ def scenario_grid(scenario: Scenario, *, use: str = "risk") -> AirspaceGrid:
     from uamopt.grid import build_grid
 
     expect(scenario, Scenario, "scenario", "scenario_grid")
+    if not isinstance(use, str) or use not in ("risk", "plan"):
+        raise ValueError(f"scenario_grid(): use must be 'risk' or 'plan', got {use!r}"[:200])
     if scenario.grid.extent is not None:
         extent = scenario.grid.extent
     else:
@@ -126,15 +128,34 @@ def plan_network(model: PlanningModel, progress=None) -> RouteNetwork:
     from uamopt.planning.problem import PlanningModel
 
     expect(model, PlanningModel, "model", "plan_network")
+    if progress is not None and not callable(getattr(progress, "update", None)):
+        raise TypeError(f"plan_network(): progress must be None or an object with update(n) (a tqdm bar, "
+                        f"uamopt.progress.Progress), got {type(progress).__name__}")
     return plan(model, progress=progress)
 
 
 def generate_flights(scenario: Scenario, network, seed: int | None = None) -> FlightSet:
     """The initial flight plan of Sec. 6.2 (Eqs. 23–29) on ``network`` (a RouteNetwork or route
     name → waypoints); ``seed`` defaults to ``schedule.plan_seed``."""
+    from collections.abc import Mapping
+
+    import numpy as np
+
     from uamopt.schedule.plan import generate_plan
 
     expect(scenario, Scenario, "scenario", "generate_flights")
+    rule = "generate_flights(): network must be a RouteNetwork (ua.plan_network) or a mapping route name -> (n, 3) waypoints"
+    if callable(getattr(network, "waypoints", None)):  # a RouteNetwork (not imported here: the planner is heavy)
+        network = network.waypoints()
+    if not isinstance(network, Mapping):
+        raise TypeError(f"{rule}, got {type(network).__name__}")
+    for name, waypoints in network.items():
+        if not isinstance(name, str):
+            raise TypeError(f"{rule} (names such as 'V1-V2'), got a route named by a {type(name).__name__}")
+        try:
+            np.asarray(waypoints, dtype=float)
+        except (TypeError, ValueError):
+            raise TypeError(f"{rule}, got {type(waypoints).__name__} {str(waypoints)[:40]!r} for route '{name}'") from None
     return generate_plan(scenario, network, scenario.schedule.plan_seed if seed is None else seed)
 
 
@@ -144,18 +165,23 @@ def build_problem(flights: FlightSet, scenario: Scenario | None = None, *, objec
     ``schedule.objective`` (weighted Eq. 20, or lexicographic)."""
     import math
 
+    from uamopt.bounds import MAX_WEIGHT
     from uamopt.schedule.flights import FlightSet
     from uamopt.schedule.model import build_problem as build
 
     expect(flights, FlightSet, "flights", "build_problem")
+    if not flights.flights:  # nothing to schedule (a FlightSet filtered to nothing)
+        raise UamoptError("the flight set is empty: there is nothing to schedule", "build_problem(flights)",
+                          "give at least one flight (ua.generate_flights or ua.load_flights)")
     if scenario is not None:
         expect(scenario, Scenario, "scenario", "build_problem")
     if weights is not None:
         if not (isinstance(weights, (list, tuple)) and len(weights) == 2
                 and all(isinstance(w, (int, float)) and not isinstance(w, bool) for w in weights)):
             raise TypeError(f"build_problem(): weights must be a pair of numbers (ω6, ω7), got {weights!r}")
-        if not all(math.isfinite(w) and w >= 0 for w in weights) or not sum(weights) > 0:
-            raise UamoptError(f"the objective weights must be finite numbers ≥ 0, not both 0, got {tuple(weights)}",
+        if not all(math.isfinite(w) and 0 <= w <= MAX_WEIGHT for w in weights) or not sum(weights) > 0:
+            raise UamoptError(f"the objective weights must be finite numbers in [0, {MAX_WEIGHT:g}] (the range of "
+                              f"schedule.weights), not both 0, got {tuple(weights)}",
                               "build_problem(weights=...)", "give e.g. (0.6, 0.4), as schedule.weights")
     kind = objective or (scenario.schedule.objective if scenario is not None else "weighted")
     return build(flights, scenario, weights=weights, objective=kind)  # type: ignore[arg-type]
@@ -213,10 +239,18 @@ def solver_profile(profile: SolverProfile | str | Path, **overrides) -> SolverPr
     """A profile by name (``highs``), path or object, with ``time_limit_s``, ``seed``,
     ``threads`` or ``options`` replaced."""
     import os
+    from collections.abc import Mapping
 
     from uamopt.solvers import SolverProfile, load_profile
 
     expect(profile, (SolverProfile, str, os.PathLike), "profile", "solver_profile")
+    fields = [f.name for f in dataclasses.fields(SolverProfile) if f.name != "solver"]
+    unknown = sorted(set(overrides) - set(fields))
+    if unknown:
+        raise TypeError(f"solver_profile(): unknown override {unknown[0]!r}; a profile takes {', '.join(fields)}")
+    if "options" in overrides and not isinstance(overrides["options"], Mapping):
+        raise TypeError(f"solver_profile(): options must be a dict of the solver's options (e.g. {{'step_s': 5.0}}), "
+                        f"got {type(overrides['options']).__name__}")
     base = profile if isinstance(profile, SolverProfile) else load_profile(profile)
     if "options" in overrides:
         overrides["options"] = {**base.options, **overrides["options"]}
@@ -230,6 +264,8 @@ def solve(problem: SchedulingProblem, profile: SolverProfile | str | Path = "gre
     from uamopt.solvers import solve as run
 
     expect(problem, SchedulingProblem, "problem", "solve")
+    if extra is not None and not callable(extra):
+        raise TypeError(f"solve(): extra must be None or a callable that edits the exact model, got {type(extra).__name__}")
     return run(problem, solver_profile(profile, **overrides), extra=extra)
 
 

@@ -418,6 +418,13 @@ def risk_field(scenario: Scenario, grid: AirspaceGrid, city: CityLayers, *, keep
     -------
     RiskField
 
+    Raises
+    ------
+    TypeError
+        An argument of another type (``scenario`` not a Scenario, ...).
+    GridError
+        ``city`` holds the layers of another grid.
+
     Examples
     --------
     >>> from uamopt import Scenario, AirspaceGrid, risk_field
@@ -431,6 +438,17 @@ def risk_field(scenario: Scenario, grid: AirspaceGrid, city: CityLayers, *, keep
     >>> bool(f.unsafe[0, 0, 4]), bool(f.unsafe[1, 0, 4])   # open ground vs above a 50 m road
     (False, True)
     """
+    from uamopt.checks import expect
+    from uamopt.errors import GridError
+
+    expect(scenario, Scenario, "scenario", "risk_field")
+    expect(grid, AirspaceGrid, "grid", "risk_field")
+    expect(city, CityLayers, "city", "risk_field")
+    expect(keep_risk, bool, "keep_risk", "risk_field")
+    if tuple(city.surface_height.shape) != tuple(grid.shape[:2]):
+        raise GridError(f"the city layers are of another grid: {city.surface_height.shape[0]} × "
+                        f"{city.surface_height.shape[1]} columns, the grid has {grid.shape[0]} × {grid.shape[1]}",
+                        "risk_field(scenario, grid, city)", "pass the layers ua.load_city(scenario, grid) returns for this grid")
     started = time.perf_counter()
     r, c = scenario.risk, RiskConstants.from_scenario(scenario)
     shape = grid.shape

@@ -119,7 +119,11 @@ def flights_folder(scenario: Scenario, out: str | Path, seed: int | None = None)
 def schedule_folder(scenario: Scenario, out: str | Path, profile, flights_file=None, network_file=None,
                     seed: int | None = None, overrides: list[str] | None = None):
     """``uamopt schedule``: solve and write flights.json, schedule.csv, summary.json; returns
-    (problem, schedule, violations found by the independent verifier in the written folder)."""
+    (problem, schedule, violations found by the independent verifier in the written folder).
+
+    The verifier reads the staged files before they are published into ``out``: a folder it
+    refuses as malformed (a track a reader accepted and it does not, a bug) is one error line with
+    nothing written; violations (a solver's bug) are published with the files, as evidence."""
     from uamopt.export.frame import schedule_provenance
     from uamopt.outputs import output_lock
     from uamopt.pipeline import build_problem, scenario_flights, scenario_grid, solve
@@ -136,6 +140,19 @@ def schedule_folder(scenario: Scenario, out: str | Path, profile, flights_file=N
         schedule = solve(problem, profile)
         bar.update(1)
         extent = {"extent_m": list(scenario_grid(scenario).extent)}  # the airspace the verifier holds tracks to
-        write_schedule(out, problem, schedule, extra=schedule_provenance(scenario, list(overrides or [])) | extent)
-        return problem, schedule, verify_dir(out)
+        violations = write_schedule(out, problem, schedule, extra=schedule_provenance(scenario, list(overrides or [])) | extent,
+                                    check=lambda stage: _verified(stage, out, verify_dir))
+        return problem, schedule, violations
+
+
+def _verified(stage: Path, out: str | Path, verify_dir) -> list[str]:
+    """``verify_dir`` on the staged folder; a refusal names the files as they will be in ``out``."""
+    from uamopt.errors import UamoptError
+
+    try:
+        return verify_dir(stage)
+    except UamoptError as exc:
+        exc.what, exc.where = (text.replace(str(stage), str(out)) for text in (exc.what, exc.where))
+        exc.args = (exc.line(),)
+        raise
 

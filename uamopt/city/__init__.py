@@ -41,7 +41,15 @@ def load_city(scenario: Scenario, grid: AirspaceGrid) -> CityLayers:
     ------
     InputFileError
         A .pbf, GeoTIFF or GeoJSON named by the scenario is missing or unreadable.
+    TypeError
+        ``scenario`` is not a Scenario or ``grid`` not an AirspaceGrid.
     """
+    from uamopt.checks import expect
+    from uamopt.grid import AirspaceGrid
+    from uamopt.scenario import Scenario
+
+    expect(scenario, Scenario, "scenario", "load_city")
+    expect(grid, AirspaceGrid, "grid", "load_city")
     source = scenario.city.source
     if source == "synthetic":
         from uamopt.city.synthetic import synthetic_city

@@ -24,6 +24,7 @@ import math
 import time
 from pathlib import Path
 
+from uamopt.checks import expect
 from uamopt.errors import UamoptError
 from uamopt.experiments.case import error_line, schedule_row, scheduling_problem
 from uamopt.progress import Progress
@@ -80,11 +81,42 @@ def _instances(problem_or_scenarios, sources: dict | None = None) -> dict:
     return out
 
 
+def _checked_seeds(seeds) -> list[int] | None:
+    """``benchmark``'s ``seeds``: None, or a sequence of distinct solver seeds 0 to SEED_MAX (32-bit,
+    as a profile's ``seed``); else ``TypeError`` (not a list of integers) or ``UamoptError`` (out of
+    range, none, repeated: ``--seeds`` too), naming ``seeds``, before anything runs."""
+    import numpy as np
+
+    from uamopt.solvers.options import SEED_MAX
+
+    if seeds is None:
+        return None
+    rule = f"benchmark(): seeds must be None or a list of solver seeds, integers from 0 to {SEED_MAX} (e.g. [0, 1, 2])"
+    if not isinstance(seeds, (list, tuple, range, np.ndarray)):
+        raise TypeError(f"{rule}, got {type(seeds).__name__}")
+    for seed in seeds:
+        if isinstance(seed, (bool, np.bool_)) or not isinstance(seed, (int, np.integer)):
+            raise TypeError(f"{rule}, got a {type(seed).__name__} ({str(seed)[:40]!r})")
+    bad = next((seed for seed in seeds if not 0 <= seed <= SEED_MAX), None)
+    if bad is not None or len(seeds) == 0 or len(set(map(int, seeds))) != len(seeds):
+        got = f"the seed {str(bad)[:40]}" if bad is not None else f"{list(seeds)!r}"[:200]
+        raise UamoptError(f"the solver seeds must be distinct integers from 0 to {SEED_MAX}, at least one, got {got}",
+                          "benchmark(seeds=...) / --seeds", "give e.g. [0, 1, 2] (HiGHS and CP-SAT take 32-bit seeds)")
+    return [int(seed) for seed in seeds]
+
+
 def _profiles(solvers, time_limit_s):
+    import os
+
     from uamopt.solvers import SolverProfile, load_profile, solver_module
 
-    profiles = [s if isinstance(s, SolverProfile) else load_profile(s)
-                for s in ([solvers] if isinstance(solvers, (str, Path)) else solvers)]
+    items = [solvers] if isinstance(solvers, (str, os.PathLike, SolverProfile)) else solvers
+    if not isinstance(items, (list, tuple)) or not all(isinstance(s, (str, os.PathLike, SolverProfile)) for s in items):
+        bad = items if not isinstance(items, (list, tuple)) else next(s for s in items
+                                                                      if not isinstance(s, (str, os.PathLike, SolverProfile)))
+        raise TypeError("benchmark(): solvers must be a list of profiles (names such as 'greedy', paths or SolverProfile), "
+                        f"got {type(bad).__name__}")
+    profiles = [s if isinstance(s, SolverProfile) else load_profile(s) for s in items]
     for profile in profiles:  # a solver of an extra not installed: its one line, not a table of error rows
         solver_module(profile.solver)
     if not profiles:
@@ -149,7 +181,7 @@ def benchmark(problem_or_scenarios, solvers, seeds=None, time_limit_s: float | N
     solvers : sequence of str, Path or SolverProfile
         Profiles (``"highs"``, ``"solvers/soa.toml"``).
     seeds : sequence of int, optional
-        Solver seeds (each profile's own seed when omitted).
+        Solver seeds, distinct, 0 to 2³¹ − 1 (each profile's own seed when omitted).
     time_limit_s : float, optional
         Applied to every profile instead of its own ``time_limit_s``.
     progress : bool
@@ -173,6 +205,12 @@ def benchmark(problem_or_scenarios, solvers, seeds=None, time_limit_s: float | N
 
     import pandas as pd
 
+    seeds = _checked_seeds(seeds)
+    expect(progress, bool, "progress", "benchmark")
+    if sources is not None and not (isinstance(sources, dict) and all(isinstance(v, dict) for v in sources.values())):
+        bad = sources if not isinstance(sources, dict) else next(v for v in sources.values() if not isinstance(v, dict))
+        raise TypeError("benchmark(): sources must be None or a dict of instance name -> {'plan_seed': ..., 'scenario': "
+                        f"..., 'set': [...]}}, got {type(bad).__name__}{'' if bad is sources else ' as a value'}")
     profiles = _profiles(solvers, time_limit_s)
     found: dict = {}
     instances = _instances(problem_or_scenarios, found)
@@ -259,11 +297,17 @@ def cmd_bench(args) -> int:
         if not seeds or len(set(seeds)) != len(seeds):
             raise UamoptError(f"--seeds {' '.join(map(str, args.seeds))} gives no distinct seeds", "--seeds",
                               "give a count (--seeds 3 runs seeds 0, 1, 2) or two or more seeds (--seeds 0 1 2)")
+        _checked_seeds(seeds)  # 32-bit solver seeds, before any instance is built
     profiles = _profiles(args.solver, args.time_limit)
-    if getattr(args, "scheduler", None):  # the windows profiles' tasks on a running Dask cluster
+    if getattr(args, "scheduler", None) is not None:  # the windows profiles' tasks on a running Dask cluster
+        from uamopt.cluster import scheduler_address
+
         if not any(p.solver == "windows" for p in profiles):
             raise UamoptError(f"--scheduler is for the windows solver, not {', '.join(p.solver for p in profiles)}",
                               "--scheduler", "add a windows profile (--solver windows), or drop --scheduler")
+        # a malformed address is bad input (one line, nothing written); a well-formed one nobody answers
+        # at is each windows run's error row (the cluster can go away between runs too)
+        scheduler_address(args.scheduler)
         profiles = [dataclasses.replace(p, options={**p.options, "scheduler": args.scheduler})
                     if p.solver == "windows" else p for p in profiles]
     airland = [path for path in args.scenario if is_airland(path)]  # OR-Library landing files: instances as they are

@@ -22,7 +22,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-from uamopt.checks import expect_path
+from uamopt.checks import expect, expect_path
 from uamopt.cluster import connect, quiet_resource_tracker  # noqa: F401 (the sweeps' cluster, shared with the windows solver)
 from uamopt.errors import UamoptError
 from uamopt.experiments.case import error_line, run_case
@@ -158,6 +158,7 @@ def sweep(path, out=None, scheduler: str | None = None, workers: int | None = No
         renamed ``NAME.parquet.set-aside``; its case is recomputed.
     """
     expect_path(path, "path", "sweep")
+    expect(small, bool, "small", "sweep")
 
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
         raise UamoptError(f"--workers must be a whole number ≥ 1, got {workers!r}", "--workers",

@@ -250,6 +250,9 @@ def read_results(path: str | Path, where: str = "--against") -> Results:
     """
     path = Path(path)
     source = str(path)
+    if path.exists() and not path.is_file():  # a folder, a FIFO: not "not found" (--update would not create it)
+        raise InputFileError(f"the results file is {'a folder' if path.is_dir() else 'not a regular file'}: {path}", where,
+                             "give the path of a results.json file (docs/benchmarks.md)")
     if not path.is_file():
         raise InputFileError(f"results file not found: {path}", where,
                              "give the path of a results.json (docs/benchmarks.md), or add --update to create it")

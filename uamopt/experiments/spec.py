@@ -38,7 +38,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
-from uamopt.checks import expect_path
+from uamopt.checks import expect, expect_path
 from uamopt.errors import ScenarioError, UamoptError
 
 STAGES = ("risk", "plan", "network", "schedule")
@@ -232,10 +232,14 @@ def _apply_small(raw: dict, where: str) -> dict:
 
 
 def _time_limit(value: Any, where: str, key: str = "time_limit_s") -> float | None:
-    if value is not None and (isinstance(value, bool) or not isinstance(value, (int, float)) or not value > 0
-                              or not math.isfinite(value)):
-        raise ScenarioError(f"{key} must be a positive number, got {value!r}", where, "give seconds, e.g. 30.0")
-    return value
+    """Every solver's time limit: the solver profiles' range (0, 10⁷] s, through the one boundary
+    check (a 400-digit integer, NaN or inf is one line, not an OverflowError)."""
+    from uamopt.bounds import check_number
+    from uamopt.solvers.options import TIME_LIMIT_S
+
+    if value is None:
+        return None
+    return check_number(value, key, where, "give seconds, e.g. 30.0", TIME_LIMIT_S, ScenarioError)
 
 
 def _seeds(raw: Any, where: str, key: str = "seeds") -> tuple[int, ...]:
@@ -253,9 +257,11 @@ def _seeds(raw: Any, where: str, key: str = "seeds") -> tuple[int, ...]:
 
 
 def _max_cases(raw: dict, where: str) -> int:
+    from uamopt.bounds import INT64_MAX, shown
+
     limit = raw.get("max_cases", MAX_CASES)
-    if isinstance(limit, bool) or not isinstance(limit, int) or limit < 1:
-        raise ScenarioError(f"max_cases must be a whole number ≥ 1, got {limit!r}", where,
+    if isinstance(limit, bool) or not isinstance(limit, int) or not 1 <= limit <= INT64_MAX:
+        raise ScenarioError(f"max_cases must be a whole number ≥ 1 (at most 2^63 − 1), got {shown(limit)}", where,
                             f"give the most cases the sweep may have, e.g. max_cases = {MAX_CASES}")
     return limit
 
@@ -318,6 +324,7 @@ def load_sweep(path: str | Path, small: bool = False) -> SweepSpec:
         stage, seeds or solvers, a case whose scenario is invalid.
     """
     expect_path(path, "path", "load_sweep")
+    expect(small, bool, "small", "load_sweep")
     from uamopt.shipped import scenario_path
 
     path = Path(scenario_path(path))  # a shipped sweep's name (variants/speed), or models/... anywhere

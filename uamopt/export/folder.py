@@ -11,7 +11,7 @@ import json
 from dataclasses import dataclass
 from pathlib import Path
 
-from uamopt.bounds import parse_error
+from uamopt.bounds import parse_error, shown
 from uamopt.errors import InputFileError
 from uamopt.export.frame import LocalFrame, synthetic_frame
 from uamopt.schedule.flights import Flight, FlightSet
@@ -109,10 +109,16 @@ def recorded_scenario(folder: ScheduleFolder, scenario_path: str | None = None, 
     if scenario_path is not None:
         return load_scenario(scenario_path, overrides or [])
     record = folder.scenario or {}
+    where = str(folder.path / "summary.json")
     if not record.get("file") or not isinstance(record["file"], str):
-        raise InputFileError("the folder records no scenario file", str(folder.path / "summary.json"),
+        raise InputFileError("the folder records no scenario file", where,
                              "pass --scenario FILE (and its --set overrides), or --risk risk.npz")
-    return load_scenario(record["file"], list(record.get("set", [])) + list(overrides or []))
+    recorded = record.get("set", [])
+    if not (isinstance(recorded, list) and all(isinstance(s, str) for s in recorded)):
+        raise InputFileError(f"the recorded scenario's 'set' is not a list of KEY=VALUE strings, got {shown(recorded)}",
+                             where, "rewrite the folder with uamopt schedule, or pass --scenario FILE (and its --set "
+                             "overrides), or --risk risk.npz")
+    return load_scenario(record["file"], recorded + list(overrides or []))
 
 
 def write_texts(folder: Path, texts: dict[str, str]) -> list[Path]:

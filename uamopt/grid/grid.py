@@ -233,15 +233,24 @@ def build_grid(extent, cell, *, memory_limit_gb: float | None = None, use: str =
     ------
     GridError
         The grid holds no cell, or its run (``use``: ``"risk"`` or ``"plan"``, :data:`MEMORY_MODEL`)
-        would need more memory than ``memory_limit_gb`` (default: 80 % of this machine's memory).
+        would need more memory than ``memory_limit_gb`` (default: 80 % of this machine's memory; a
+        number of GB in (0, 1e6], as ``grid.memory_limit_gb``).
+    ValueError
+        ``use`` is neither ``"risk"`` nor ``"plan"``.
 
     Examples
     --------
     >>> build_grid((2500, 4500, 360), (50, 50, 30)).shape
     (50, 90, 12)
     """
-    from uamopt.bounds import MAX_COORD_M, Range, check_cell, shown
+    from uamopt.bounds import MAX_COORD_M, Range, check_cell, check_number, shown
 
+    if not isinstance(use, str) or use not in MEMORY_MODEL:
+        raise ValueError(f"build_grid(): use must be one of {', '.join(map(repr, MEMORY_MODEL))}, got {shown(use)}")
+    if memory_limit_gb is not None:
+        check_number(memory_limit_gb, "memory_limit_gb", "build_grid(memory_limit_gb=...)",
+                     "give gigabytes, as grid.memory_limit_gb, or None for 80 % of this machine's memory",
+                     Range(0.0, 1e6, lo_open=True), GridError)
     cell = check_cell(cell, "build_grid(cell=...)", "give three cell sizes in metres, each > 0, e.g. (50, 50, 30)", GridError)
     if not (isinstance(extent, (list, tuple)) and len(extent) == 3 and all(Range(0.0, MAX_COORD_M).holds(e) for e in extent)):
         raise GridError(f"the extent must be three sizes (x_max, y_max, z_max) in [0, {MAX_COORD_M:g}] m, got {shown(extent)}",

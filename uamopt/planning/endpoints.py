@@ -83,13 +83,24 @@ def default_endpoints(scenario: Scenario) -> tuple[Endpoint, Endpoint]:
     return origin, destination
 
 
-def as_endpoint(scenario: Scenario, value, label: str) -> Endpoint:
-    """An :class:`Endpoint` from an Endpoint, a vertiport name or (x, y, z) metres."""
+def as_endpoint(scenario: Scenario, value, label: str, function: str = "plan_track") -> Endpoint:
+    """An :class:`Endpoint` from an Endpoint, a vertiport name or (x, y, z) metres; anything else
+    (a 2-D point, None, a string among the numbers) is a ``TypeError`` naming ``function``'s
+    ``label`` argument (``origin``, ``destination``)."""
     if isinstance(value, Endpoint):
         return value
     if isinstance(value, str):
         return vertiport_endpoint(scenario, value, f"{label} {value}")
-    point = tuple(float(v) for v in value)
+    import numbers
+
+    import numpy as np
+
+    items = list(value) if isinstance(value, (list, tuple, np.ndarray)) and np.ndim(value) == 1 else None
+    if items is None or len(items) != 3 or not all(isinstance(v, numbers.Real) and not isinstance(v, bool) for v in items):
+        got = f"{len(items)} values {tuple(items)!r}"[:80] if items is not None else type(value).__name__
+        raise TypeError(f"{function}(): {label} must be a vertiport name or a point of 3 numbers (x, y, z) in metres, "
+                        f"got {got}")
+    point = tuple(float(v) for v in items)
     return Endpoint(point, f"{label} (" + ", ".join(f"{v:g}" for v in point) + ")")  # type: ignore[arg-type]
 
 

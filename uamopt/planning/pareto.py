@@ -27,6 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from uamopt.checks import expect
 from uamopt.planning.endpoints import as_endpoint
 from uamopt.planning.problem import PlanningModel
 from uamopt.planning.search import grid_search
@@ -112,12 +113,21 @@ def weight_sweep(model: PlanningModel, origin, destination, weights: int | Seque
 
     Raises
     ------
+    TypeError
+        ``model`` is not a PlanningModel, ``origin`` or ``destination`` not a vertiport name or
+        (x, y, z), ``weights`` neither an int nor a sequence, ``buffer`` not a bool.
     ValueError
         ``weights`` is an int below 2, or a pair is negative, not finite or (0, 0).
     UamoptError, NoTrackError
         As :func:`plan_track`, for the end points.
     """
-    o, d = as_endpoint(model.scenario, origin, "origin"), as_endpoint(model.scenario, destination, "destination")
+    expect(model, PlanningModel, "model", "weight_sweep")
+    if isinstance(weights, bool) or not isinstance(weights, (int, np.integer, list, tuple, np.ndarray)):
+        raise TypeError(f"weight_sweep(): weights must be an int ≥ 2 or a sequence of (ω4, ω5) pairs, "
+                        f"got {type(weights).__name__}")
+    expect(buffer, bool, "buffer", "weight_sweep")
+    o = as_endpoint(model.scenario, origin, "origin", "weight_sweep")
+    d = as_endpoint(model.scenario, destination, "destination", "weight_sweep")
     start = endpoint_cell(model, np.asarray(o.point, dtype=float), "origin", o.where)
     goal = endpoint_cell(model, np.asarray(d.point, dtype=float), "destination", d.where)
     eps = tie_break_weights(model)

@@ -208,17 +208,26 @@ STAGE_COLOUR = {"shortest": "#7f7f7f", "initial": "#1f77b4", "equivalent": "#ff7
 
 
 def _read_json(path: Path) -> dict:
-    import json
-
+    from uamopt.bounds import read_json
     from uamopt.errors import InputFileError
 
-    try:
-        doc = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, ValueError) as exc:
-        raise InputFileError(f"cannot read {path.name}: {exc}", str(path), "rewrite it with uamopt") from None
+    # malformed, not UTF-8, nested too deeply, a number beyond Python's limit: one line each
+    doc = read_json(path, path.name, str(path), f"the {path.name} uamopt wrote")
     if not isinstance(doc, dict):
         raise InputFileError(f"{path.name} is not a JSON object", str(path), "rewrite it with uamopt")
     return doc
+
+
+def _mapping(doc: dict, key: str, where: Path) -> dict:
+    """``doc[key]``: a JSON object (name -> entry), ``{}`` when absent or null."""
+    from uamopt.bounds import shown
+    from uamopt.errors import InputFileError
+
+    value = doc.get(key) or {}
+    if not isinstance(value, dict):
+        raise InputFileError(f"'{key}' in {where.name} is not a JSON object (name -> entry), got {shown(value)}",
+                             str(where), "rewrite it with uamopt")
+    return value
 
 
 def _polyline(points, where: Path) -> np.ndarray:
@@ -237,6 +246,7 @@ def _polyline(points, where: Path) -> np.ndarray:
 def _static_view(here: Path, risk, scenario, overrides, city: bool, go) -> Explorer:
     """A folder of ``uamopt risk``, ``plan``, ``network`` or ``reproduce``: the city, the unsafe
     airspace and the tracks it holds (the four stages of Table 2, the network's routes), no playback."""
+    from uamopt.bounds import shown
     from uamopt.errors import InputFileError
 
     tracks = here / "tracks.json"
@@ -247,7 +257,7 @@ def _static_view(here: Path, risk, scenario, overrides, city: bool, go) -> Explo
                              "give a folder written by uamopt risk, plan, network, schedule or reproduce")
     lines, ports = [], {}
     if network.is_file():
-        for name, r in (_read_json(network).get("routes") or {}).items():
+        for name, r in _mapping(_read_json(network), "routes", network).items():
             wp = _polyline(r.get("waypoints") if isinstance(r, dict) else None, network)
             lines.append((f"track {name}", wp, None))
             a, _, b = str(name).partition("-")
@@ -257,13 +267,16 @@ def _static_view(here: Path, risk, scenario, overrides, city: bool, go) -> Explo
     if tracks.is_file():
         doc = _read_json(tracks)
         record = doc.get("scenario") if isinstance(doc.get("scenario"), dict) else {}
-        for stage, body in (doc.get("stages") or {}).items():
+        for stage, body in _mapping(doc, "stages", tracks).items():
             lines.append((f"{stage} track", _polyline(body.get("waypoints") if isinstance(body, dict) else None, tracks),
                           STAGE_COLOUR.get(stage)))
     traces = []
     if city:
         if risk is None and npz.is_file():
             risk = npz
+        if risk is None and scenario is None and not isinstance(record.get("file") or "", str):
+            raise InputFileError(f"the recorded scenario file is not a path, got {shown(record['file'])}", str(tracks),
+                                 "rewrite it with uamopt plan, or pass --scenario FILE, --risk risk.npz or --no-city")
         if risk is None and scenario is None and not record.get("file"):
             raise InputFileError("the folder records no scenario file for the city", str(here),
                                  "pass --scenario FILE (and its --set keys), --risk risk.npz, or --no-city")

@@ -366,6 +366,9 @@ def plot_sweep(table, kind: str | None = None, ax=None, *, x: str | None = None,
     from uamopt.errors import UamoptError
 
     expect(table, pd.DataFrame, "table", "plot_sweep")
+    for name, value in (("kind", kind), ("x", x), ("hue", hue), ("y", y)):  # a column's or a study's name
+        if value is not None:
+            expect(value, str, name, "plot_sweep")
     if kind is None:
         return sweep_lines(table, x=x, hue=hue, y=y, ax=ax)
     if kind not in KEYS:

@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import math
 import tomllib
+from collections.abc import Sequence
+from contextvars import ContextVar
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -147,31 +149,65 @@ def _brief(text: str, limit: int = 80) -> str:
     return text if len(text) <= limit else f"{text[:limit - 1]}… ({len(text):,} characters)"
 
 
+def validation_error(exc: ValidationError, source: str, overrides: Sequence[str] = ()) -> ScenarioError:
+    """pydantic's error as one line naming the key, its meaning and its range: ``source`` is where the
+    values came from (the file, ``Scenario(...)``), or the ``--set`` item that set the key."""
+    err = exc.errors()[0]
+    loc = tuple(err["loc"])
+    key = ".".join(str(p) for p in loc if not isinstance(p, int)) or "<root>"
+    where = source
+    for item in overrides:
+        if item.partition("=")[0].strip() and key.startswith(item.partition("=")[0].strip()):
+            where = f"--set {_brief(item)}"
+    if err["type"] == "extra_forbidden":
+        keys = _section_keys(loc)
+        section = ".".join(str(p) for p in loc[:-1]) or "top level"
+        fix = f"valid keys in [{section}] are {', '.join(keys)}" if keys else "remove it"
+        return ScenarioError(f"unknown key '{key}'", where, fix)
+    value = err.get("input")
+    shown = f" {_brief(repr(value))}" if not isinstance(value, (dict, list, tuple)) or len(repr(value)) < 60 else ""
+    msg = err["msg"].replace("Value error, ", "")
+    info = _field_info(loc)
+    fix = f"'{key}' is {info.description}" if info is not None and info.description else "see uamopt/scenario/schema.py"
+    valid = _range_text([str(p) for p in loc if not isinstance(p, int)])
+    if valid and err["type"] not in ("literal_error", "missing"):
+        fix += f"; it takes {valid}"
+    return ScenarioError(f"invalid value{shown} for '{key}': {msg}", where, fix)
+
+
+def checked_overrides(overrides, function: str) -> list[str]:
+    """``overrides`` (None, or a list or tuple of ``"KEY=VALUE"`` strings) as a list; else ``TypeError``
+    naming ``function``'s ``overrides`` (a bare string would be read one character at a time)."""
+    if overrides is None:
+        return []
+    rule = f'{function}(): overrides must be a list or tuple of "KEY=VALUE" strings (e.g. ["grid.cell=[10,10,10]"]) or None'
+    if not isinstance(overrides, (list, tuple)):
+        raise TypeError(f"{rule}, got {type(overrides).__name__}")
+    for n, item in enumerate(overrides):
+        if not isinstance(item, str):
+            raise TypeError(f"{rule}, got {type(item).__name__} {str(item)[:40]!r} as item {n}")
+    return list(overrides)
+
+
+#: where the values being validated came from, for :func:`validation_error`: pydantic calls
+#: ``Scenario.__init__`` from ``model_validate`` too (a model with its own ``__init__``), and that
+#: ``__init__`` turns pydantic's error into the one line; outside :func:`validate`, ``Scenario(...)``
+_SOURCE: ContextVar[tuple[str, tuple[str, ...]]] = ContextVar("scenario_source", default=("Scenario(...)", ()))
+
+
+def source_of_values() -> tuple[str, tuple[str, ...]]:
+    """(source, overrides) of the scenario being validated (``Scenario(...)`` when built directly)."""
+    return _SOURCE.get()
+
+
 def validate(raw: dict, source: str, base_dir: Path, overrides: list[str]) -> Scenario:
+    token = _SOURCE.set((source, tuple(overrides)))
     try:
         scenario = Scenario.model_validate(raw)
-    except ValidationError as exc:
-        err = exc.errors()[0]
-        loc = tuple(err["loc"])
-        key = ".".join(str(p) for p in loc if not isinstance(p, int)) or "<root>"
-        where = source
-        for item in overrides:
-            if item.partition("=")[0].strip() and key.startswith(item.partition("=")[0].strip()):
-                where = f"--set {_brief(item)}"
-        if err["type"] == "extra_forbidden":
-            valid = _section_keys(loc)
-            section = ".".join(str(p) for p in loc[:-1]) or "top level"
-            fix = f"valid keys in [{section}] are {', '.join(valid)}" if valid else "remove it"
-            raise ScenarioError(f"unknown key '{key}'", where, fix) from None
-        value = err.get("input")
-        shown = f" {_brief(repr(value))}" if not isinstance(value, (dict, list, tuple)) or len(repr(value)) < 60 else ""
-        msg = err["msg"].replace("Value error, ", "")
-        info = _field_info(loc)
-        fix = f"'{key}' is {info.description}" if info is not None and info.description else "see uamopt/scenario/schema.py"
-        valid = _range_text([str(p) for p in loc if not isinstance(p, int)])
-        if valid and err["type"] not in ("literal_error", "missing"):
-            fix += f"; it takes {valid}"
-        raise ScenarioError(f"invalid value{shown} for '{key}': {msg}", where, fix) from None
+    except ValidationError as exc:  # (Scenario.__init__ raises the ScenarioError itself)
+        raise validation_error(exc, source, overrides) from None
+    finally:
+        _SOURCE.reset(token)
     scenario._base_dir = base_dir
     scenario._source = source
     return scenario
@@ -184,15 +220,18 @@ def load_scenario(path: str | Path, overrides: list[str] | None = None) -> Scena
     ----------
     path : str or Path
         The scenario file (``models/paper_case.toml``).
-    overrides : list of str
-        ``KEY=VALUE`` items, dotted keys, TOML values (``grid.cell=[10,10,10]``).
+    overrides : list or tuple of str, optional
+        ``KEY=VALUE`` items, dotted keys, TOML values (``grid.cell=[10,10,10]``); None: none.
 
     Raises
     ------
     ScenarioError
         Missing or malformed file, unknown key, value out of range.
+    TypeError
+        ``path`` is not a path, ``overrides`` not a list or tuple of strings.
     """
     expect_path(path, "path", "load_scenario")
+    overrides = checked_overrides(overrides, "load_scenario")
     from uamopt.shipped import scenario_path
 
     path = Path(scenario_path(path))  # a shipped scenario's name, or models/... outside the checkout
@@ -214,5 +253,5 @@ def load_scenario(path: str | Path, overrides: list[str] | None = None) -> Scena
     except ValueError as exc:  # an integer of more than 4300 digits (Python's int-string limit)
         raise ScenarioError(f"the scenario holds {parse_error(exc)}", str(path),
                             "every number of a scenario has a range (docs/interfaces.md); write it in range") from None
-    raw = apply_overrides(raw, list(overrides or []))
-    return validate(raw, str(path), path.resolve().parent, list(overrides or []))
+    raw = apply_overrides(raw, overrides)
+    return validate(raw, str(path), path.resolve().parent, overrides)

@@ -446,6 +446,21 @@ class Scenario(_Section):
     _base_dir: Path = PrivateAttr(default_factory=Path.cwd)
     _source: str = PrivateAttr(default="<defaults>")
 
+    def __init__(self, **data: Any) -> None:
+        """``Scenario(grid={"cell": (25, 25, 30)}, ...)``: a value the schema refuses is one
+        :class:`~uamopt.errors.ScenarioError` line naming the key and its range, as
+        :func:`~uamopt.scenario.loading.load_scenario` gives (not pydantic's many-line error).
+        pydantic calls this from ``model_validate`` as well, so a file's or ``--set``'s error is
+        made here too, naming its source (:func:`uamopt.scenario.loading.source_of_values`)."""
+        from pydantic import ValidationError
+
+        try:
+            super().__init__(**data)
+        except ValidationError as exc:
+            from uamopt.scenario.loading import source_of_values, validation_error  # the input side of this schema
+
+            raise validation_error(exc, *source_of_values()) from None
+
     @property
     def source(self) -> str:
         """Where the scenario came from (file path), for error messages."""
@@ -459,7 +474,8 @@ class Scenario(_Section):
     def with_overrides(self, overrides: list[str]) -> Scenario:
         """A copy with ``KEY=VALUE`` overrides applied and validated again (errors as
         :func:`~uamopt.scenario.loading.load_scenario`'s)."""
-        from uamopt.scenario.loading import apply_overrides, validate  # the input side of this schema
+        from uamopt.scenario.loading import apply_overrides, checked_overrides, validate  # the input side of this schema
 
+        overrides = checked_overrides(overrides, "Scenario.with_overrides")
         raw = self.model_dump(mode="python")
         return validate(apply_overrides(raw, overrides), self._source, self._base_dir, overrides)

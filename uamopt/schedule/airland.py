@@ -29,6 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
+from uamopt.bounds import DURATION_S, TIME_S, Range, check_number, shown
 from uamopt.checks import expect_path
 from uamopt.errors import InputFileError
 
@@ -39,36 +40,85 @@ _TRACK = np.array([[0.0, 0.0, 0.0], [25.0, 0.0, 0.0]])
 _SPEED_MPS = 25.0
 
 
+#: the file's numbers (docs/interfaces.md: every number passes one boundary check before any arithmetic)
+AIRCRAFT = Range(1, 1_000_000_000, integer=True)  # P: the scenario keys' range of a count
+COST = Range(0.0, 1e6)  # g_i, h_i per time unit: the range of an objective's weight
+_FIELDS = (("appearance time", TIME_S), ("earliest time E", TIME_S), ("target time T", TIME_S),
+           ("latest time L", TIME_S), ("early cost g", COST), ("late cost h", COST))
+_FIX = "per aircraft: appearance E T L g h (times in [-1e7, 1e7], costs in [0, 1e6]) and P separations in [0, 1e7]"
+
+
+def _exact(token: str):
+    """A token as the number it spells, exactly (an int of any length where it is one), for the
+    error line: 10**400 is named as the 401-digit integer, not as ``inf``."""
+    try:
+        return int(token)
+    except ValueError:  # not an integer literal, or one beyond Python's int-string limit (named as written)
+        return token if token.lstrip("+-").isdigit() else float(token)
+
+
 def parse_airland(path: str | Path) -> dict:
     """The numbers of an OR-Library airland file: P, and per aircraft E, T, L, g, h and the (P, P)
-    separation matrix S (diagonal ignored)."""
+    separation matrix S (diagonal ignored).
+
+    Every number is checked before any arithmetic: P a whole number in [1, 10⁹] (the count of
+    numbers the file must hold is computed from it exactly, before anything is allocated), times
+    within ±10⁷, costs in [0, 10⁶], separations in [0, 10⁷] (the diagonal, ignored, within ±10⁷),
+    E ≤ T ≤ L. Anything else is one :class:`~uamopt.errors.InputFileError` naming the value."""
     path = Path(path)
+    where = str(path)
     try:
         tokens = path.read_text(encoding="utf-8").split()
     except (OSError, UnicodeDecodeError) as exc:
-        raise InputFileError(f"cannot read the airland file: {getattr(exc, 'strerror', None) or exc}", str(path),
+        raise InputFileError(f"cannot read the airland file: {getattr(exc, 'strerror', None) or exc}", where,
                              "give an OR-Library airland text file") from None
     try:
-        values = [float(t) for t in tokens]
-    except ValueError as exc:
-        raise InputFileError(f"not a number: {exc}", str(path), "an airland file holds whitespace-separated numbers") from None
-    if len(values) < 2 or values[0] != int(values[0]) or values[0] < 1:
-        raise InputFileError("the first number is not an aircraft count", str(path), "start with 'P freeze_time'")
-    p = int(values[0])
-    need = 2 + p * (6 + p)
+        values = np.array([float(t) for t in tokens], dtype=float)
+    except ValueError:
+        n, word = next((n, t) for n, t in enumerate(tokens) if not _is_number(t))
+        raise InputFileError(f"number {n + 1} is not a number: {shown(word)}", where,
+                             "an airland file holds whitespace-separated numbers") from None
+    if len(values) < 2:
+        raise InputFileError(f"{len(values)} numbers, expected at least 2", where,
+                             "start with 'P freeze_time' (P: the number of aircraft)")
+    count = _exact(tokens[0])
+    count = int(count) if isinstance(count, float) and count.is_integer() else count  # "10.0" is 10
+    p = check_number(count, "the aircraft count P (the first number)", where,
+                     "start with 'P freeze_time', P the number of aircraft", AIRCRAFT)
+    check_number(_exact(tokens[1]), "the freeze time (the second number)", where, "give a time in the file's unit",
+                 TIME_S)
+    need = 2 + p * (6 + p)  # exact whatever P: compared before anything of that size exists
     if len(values) != need:
-        raise InputFileError(f"{len(values)} numbers for {p} aircraft, expected {need}", str(path),
-                             "per aircraft: appearance E T L g h and P separations")
-    rows = np.array(values[2:], dtype=float).reshape(p, 6 + p)
+        raise InputFileError(f"{len(values)} numbers for {p} aircraft, expected {need}", where, _FIX)
+    rows = values[2:].reshape(p, 6 + p)
+    lo = np.empty_like(rows)
+    hi = np.empty_like(rows)
+    for k, (_, valid) in enumerate(_FIELDS):
+        lo[:, k], hi[:, k] = valid.lo, valid.hi
+    lo[:, 6:], hi[:, 6:] = DURATION_S.lo, DURATION_S.hi
+    diagonal = (np.arange(p), 6 + np.arange(p))
+    lo[diagonal], hi[diagonal] = TIME_S.lo, TIME_S.hi  # ignored, but a number like every other
+    outside = ~((rows >= lo) & (rows <= hi))  # True for NaN
+    if outside.any():
+        i, k = (int(v) for v in np.argwhere(outside)[0])
+        name, valid = _FIELDS[k] if k < 6 else (f"separation S_{i + 1},{k - 5}", TIME_S if k - 6 == i else DURATION_S)
+        check_number(_exact(tokens[2 + i * (6 + p) + k]), f"aircraft {i + 1}: {name}", where, _FIX, valid)
     e, t, l_, g, h = (rows[:, k] for k in range(1, 6))
-    if np.any(e > t) or np.any(t > l_) or np.any(g < 0) or np.any(h < 0):
-        bad = int(np.flatnonzero((e > t) | (t > l_) | (g < 0) | (h < 0))[0]) + 1
-        raise InputFileError(f"aircraft {bad}: needs E ≤ T ≤ L and costs ≥ 0", str(path), "check that aircraft's line")
+    if np.any(e > t) or np.any(t > l_):
+        bad = int(np.flatnonzero((e > t) | (t > l_))[0])
+        raise InputFileError(f"aircraft {bad + 1}: needs E ≤ T ≤ L, got E {e[bad]:g}, T {t[bad]:g}, L {l_[bad]:g}", where,
+                             "check that aircraft's line")
     sep = rows[:, 6:].copy()
     np.fill_diagonal(sep, 0.0)
-    if np.any(sep < 0):
-        raise InputFileError("a negative separation", str(path), "separations are times ≥ 0")
     return {"aircraft": p, "earliest": e, "target": t, "latest": l_, "early_cost": g, "late_cost": h, "separation": sep}
+
+
+def _is_number(token: str) -> bool:
+    try:
+        float(token)
+    except ValueError:
+        return False
+    return True
 
 
 def read_airland(path: str | Path):

@@ -3,7 +3,9 @@
 A planned track (Sec. 4.2) stays in admissible cells by construction; a track from a file is
 untrusted input. Before anything is scheduled each one must
 
-- lie inside the scenario's grid, [0, x_max] × [0, y_max] × [0, z_max] (Sec. 3);
+- lie inside the scenario's grid, [0, x_max] × [0, y_max] × [0, z_max] (Sec. 3), by
+  :func:`uamopt.bounds.outside_grid`, the rule the flights reader and ``uamopt verify`` apply too
+  (1e-6 m of slack on the top faces, none below 0);
 - stay above the ground datum, z > 0: flights are flown airborne (take-off and landing are not
   modelled, docs/readings.md), so a track at z = 0 is not a flight;
 - stay above the city's surface (building tops and ground, the obstacles of Eq. 15) at every
@@ -22,9 +24,10 @@ from collections.abc import Mapping
 
 import numpy as np
 
+from uamopt.bounds import GRID_TOL_M, outside_grid
 from uamopt.errors import InputFileError
 
-TOL_M = 1e-6  # slack for coordinates on the grid's faces, m
+TOL_M = GRID_TOL_M  # slack for a height on the ground or the city's surface, m
 SAMPLES_PER_CELL = 4  # surface samples per cell side along a segment
 
 
@@ -66,7 +69,7 @@ def check_in_airspace(extent, tracks: Mapping[str, np.ndarray], source: str, kin
     """
     extent = np.asarray(extent, dtype=float)
     for name, w in _unique(tracks):
-        bad = np.any((w < -TOL_M) | (w > extent + TOL_M), axis=1)
+        bad = outside_grid(w, extent)
         if bad.any():
             p = ", ".join(f"{v:g}" for v in w[np.argmax(bad)])
             raise InputFileError(f"waypoint ({p}) is outside the grid [0, {', '.join(f'{e:g}' for e in extent)}] m",

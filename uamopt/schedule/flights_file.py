@@ -36,6 +36,7 @@ from uamopt.bounds import (
     check_cell,
     check_number,
     check_points,
+    outside_grid,
     read_json,
 )
 from uamopt.errors import InputFileError
@@ -99,9 +100,9 @@ def _vertical(a: np.ndarray, b: np.ndarray, up: bool) -> bool:
 def check_flightset(flightset: FlightSet, grid: AirspaceGrid | None = None, source: str = "flights.json") -> None:
     """Validate the rules (once, at the boundary); raise :class:`InputFileError`.
 
-    Checks: unique ids; waypoints inside the grid (when given); planned departure ≥ T_s and
-    planned arrival ≤ T_f; per aircraft, no two flights overlap in planned time
-    (next planned departure ≥ previous planned arrival + ΔT, Eq. 27).
+    Checks: unique ids; waypoints inside the grid (when given; :func:`uamopt.bounds.outside_grid`,
+    the verifier's rule); planned departure ≥ T_s and planned arrival ≤ T_f; per aircraft, no two
+    flights overlap in planned time (next planned departure ≥ previous planned arrival + ΔT, Eq. 27).
     """
     seen: set[str] = set()
     for f in flightset.flights:
@@ -116,7 +117,7 @@ def check_flightset(flightset: FlightSet, grid: AirspaceGrid | None = None, sour
     if grid is not None:
         extent = np.asarray(grid.extent)
         for f in flightset.flights:
-            bad = np.any((f.waypoints < -TIME_TOL_S) | (f.waypoints > extent + TIME_TOL_S), axis=1)
+            bad = outside_grid(f.waypoints, extent)  # the rule of uamopt/schedule/airspace.py and of uamopt verify
             if np.any(bad):
                 p = tuple(float(v) for v in f.waypoints[np.argmax(bad)])
                 raise InputFileError(

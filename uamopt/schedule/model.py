@@ -32,10 +32,11 @@ The objective, the pair view of the conflicts and "must operate" are defined onc
 from __future__ import annotations
 
 import csv
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
-from typing import TYPE_CHECKING, Literal
+from typing import TYPE_CHECKING, Literal, TypeVar
 
 import numpy as np
 
@@ -48,6 +49,7 @@ from uamopt.schedule.occupancy import ConflictTable, conflict_table
 if TYPE_CHECKING:
     from uamopt.scenario import Scenario
 
+T = TypeVar("T")
 Status = Literal["optimal", "optimal_on_grid", "feasible", "time_limit", "infeasible", "error"]
 #: ``optimal``: proved for the continuous problem (Sec. 4.3); ``optimal_on_grid``: proved only for a
 #: restriction of it (delays on a grid or lattice, ``extras["model_kind"]``), not for continuous delays
@@ -359,8 +361,14 @@ def _fmt(value: float) -> str:
     return repr(float(value))
 
 
-def write_schedule(out_dir: str | Path, problem: SchedulingProblem, schedule: Schedule, *, extra: dict | None = None) -> None:
+def write_schedule(out_dir: str | Path, problem: SchedulingProblem, schedule: Schedule, *, extra: dict | None = None,
+                   check: Callable[[Path], T] | None = None) -> T | None:
     """Write flights.json, schedule.csv and summary.json into ``out_dir``, all or nothing.
+
+    ``check`` (optional) is called on the staged folder, complete, before anything is published
+    into ``out_dir``: an exception it raises leaves ``out_dir`` as it was; what it returns is
+    returned (``uamopt schedule`` verifies the files it is about to publish,
+    :func:`uamopt.workflows.schedule_folder`).
 
     ``schedule.csv``: flight, aircraft, route, operated (1/0), planned_departure_s, delay_s,
     departure_s, arrival_s; a cancelled flight has delay 0 and empty departure and arrival.
@@ -405,3 +413,4 @@ def write_schedule(out_dir: str | Path, problem: SchedulingProblem, schedule: Sc
                     _fmt(dep[i]) if on else "", _fmt(arr[i]) if on else "",
                 ])
         write_json(stage / "summary.json", summary)
+        return check(stage) if check is not None else None

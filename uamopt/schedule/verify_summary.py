@@ -1,8 +1,10 @@
 """summary.json checks of the independent verifier (uamopt/schedule/verify.py): counts (flights and
 aircraft when recorded, operated, cancelled), delays and the objective recomputed from the schedule
-(Eqs. 20-22; G = 0 aircraft, an empty schedule, has average delay 0), the recorded grid extent, and
-the summary's own fields (an object, two finite weights), since the folder is untrusted input: a
-number is a JSON number (not a bool) finite as a float (``finite``: a 400-digit integer is not)."""
+(Eqs. 20-22; G = 0 aircraft, an empty schedule, has average delay 0; an objective that cannot be
+recomputed as a finite number is a violation, never a pass), the recorded grid extent (by
+:func:`uamopt.bounds.outside_grid`, the readers' rule), and the summary's own fields (an object, two
+finite weights in the range of ``schedule.weights``), since the folder is untrusted input: a number
+is a JSON number (not a bool) finite as a float (``finite``: a 400-digit integer is not)."""
 
 from __future__ import annotations
 
@@ -11,6 +13,7 @@ import math
 from pathlib import Path
 from typing import TypeGuard
 
+from uamopt.bounds import MAX_WEIGHT, outside_grid
 from uamopt.errors import InputFileError
 
 TOL_S = 1e-6  # tolerance on every time and total, s (relative above 1)
@@ -76,6 +79,10 @@ def check_summary(path: Path, spec: dict, flown: list[dict], n_aircraft: int) ->
             upper = sum(max(0.0, min(f["max_delay"], spec["service_end_s"] - f["planned"] - f["duration"]))
                         for f in spec["flights"])
             expect["objective"] = -len(flown) + total / (upper + 1.0)
+        if not math.isfinite(expect["objective"]):  # never a pass: the recorded objective cannot be checked
+            out.append(f"summary.json: the objective cannot be recomputed (weights = {shown(summary['weights'])}, "
+                       f"{expect['objective']:g} from the schedule)")
+            del expect["objective"]
     for key, value in expect.items():
         got = summary.get(key)
         if not finite(got) or not close(float(got), float(value)):
@@ -86,10 +93,11 @@ def check_summary(path: Path, spec: dict, flown: list[dict], n_aircraft: int) ->
 
 
 def read_weights(raw, where: str) -> tuple[float, float]:
-    """(ω6, ω7) of summary.json: two finite numbers, else the folder is malformed."""
-    if not isinstance(raw, list) or len(raw) != 2 or not all(finite(w) for w in raw):
-        raise InputFileError(f"weights must be two finite numbers (ω6, ω7), got {shown(raw)}", where,
-                             "rewrite it with uamopt schedule")
+    """(ω6, ω7) of summary.json: two finite numbers in [0, ``MAX_WEIGHT``] (the range of
+    ``schedule.weights``, in which ω6·delay − ω7·S stays finite), else the folder is malformed."""
+    if not isinstance(raw, list) or len(raw) != 2 or not all(finite(w) and 0 <= w <= MAX_WEIGHT for w in raw):
+        raise InputFileError(f"weights must be two finite numbers (ω6, ω7) in [0, {MAX_WEIGHT:g}] (the range of "
+                             f"schedule.weights), got {shown(raw)}", where, "rewrite it with uamopt schedule")
     return float(raw[0]), float(raw[1])
 
 
@@ -102,7 +110,8 @@ def _off_grid(extent, spec: dict, where: str) -> list[str]:
                              "rewrite it with uamopt schedule")
     out = []
     for f in spec["flights"]:
-        p = next((p for p in f["waypoints"] if any(p[k] > extent[k] + 1e-6 for k in range(3))), None)
+        off = outside_grid(f["waypoints"], extent)  # the readers' rule (uamopt/bounds.py): one tolerance
+        p = f["waypoints"][int(off.argmax())] if off.any() else None
         if p is not None:
             out.append(f"flight {f['id']}: waypoint ({', '.join(f'{v:g}' for v in p)}) outside the grid "
                        f"[0, {', '.join(f'{e:g}' for e in extent)}] m of summary.json (Sec. 3)")
