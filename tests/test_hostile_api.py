@@ -462,3 +462,17 @@ def test_readers_and_verifier_share_one_rule():
     extent = (10.0, 10.0, 10.0)
     assert bounds.outside_grid([[-5e-7, 1, 1], [1, -5e-7, 1], [10 + 2e-6, 1, 1]], extent).tolist() == [True, True, True]
     assert bounds.outside_grid([[0, 0, 0], [5e-7, 1, 1], [10 + 5e-7, 10, 10]], extent).tolist() == [False, False, False]
+
+
+def test_a_plan_too_large_is_refused_before_the_network_is_planned(tmp_path, capsys):
+    """grid.memory_limit_gb so small that planning the network would be refused by the grid's own
+    guard: the plan's guard (schedule.memory_limit_gb defaults to it) speaks first, so the plan's
+    size is checked before any risk field or network is computed."""
+    from uamopt.cli import main
+
+    out = tmp_path / "f"
+    code = main(["flights", "models/paper_case.toml", "--set", "grid.memory_limit_gb=0.0001", "--set",
+                 "schedule.flights=1000", "--set", "schedule.aircraft=100", "--out", str(out)])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1 and "a plan of 1,000 flights of 100 aircraft needs about" in err[0], err
+    assert not out.exists()

@@ -223,6 +223,10 @@ def scenario_flights(scenario: Scenario, flights_file=None, network_file=None, s
 
     if not (flights_file or network_file):
         scenario.network.route_list()  # a network without routes is refused before anything is computed
+    if not flights_file:  # a plan too large for the memory is refused before the network is planned
+        from uamopt.schedule.plan import check_plan_memory
+
+        check_plan_memory(scenario, scenario.schedule.flights or 0, scenario.schedule.aircraft)
     network = checked_network(scenario, network_file) if network_file else None
     if flights_file:
         grid = scenario_grid(scenario)
