@@ -233,3 +233,17 @@ def test_an_exact_solver_always_reports_a_bound(paper_600):
     assert schedule.bound is not None and np.isfinite(schedule.bound) and schedule.bound <= schedule.objective
     if schedule.extras.get("bound_source", "").startswith("the separable"):
         assert schedule.bound == pytest.approx(watchdog.separable_bound(paper_600))
+
+
+def test_a_solve_on_a_worker_of_uamopts_cluster_is_watched():
+    """uamopt's LocalCluster starts its workers non-daemonic, so a sweep's exact solve there runs in
+    a child its time limit can end (a daemonic Dask worker could start none)."""
+    pytest.importorskip("distributed")
+    from uamopt.cluster import connect
+
+    client, cluster = connect(None, 1, 1)
+    try:
+        assert client.submit(bodies.watched_in_a_worker, pure=False).result(timeout=300) == "child process"
+    finally:
+        client.close()
+        cluster.close()

@@ -61,3 +61,12 @@ def broken_report_body(problem, profile, extra):
     watchdog.report_incumbent(problem, np.ones(3, bool), np.zeros(3), "test: all on time (conflicts)")
     watchdog.report_incumbent(problem, np.array([True, False, False]), np.zeros(3), "test: only A1")
     time.sleep(3600)
+
+
+def watched_in_a_worker() -> str:
+    """Run on a Dask worker of uamopt's own LocalCluster: how a highs solve there was run."""
+    from instances import crossing_problem
+
+    from uamopt.solvers import SolverProfile, solve
+
+    return solve(crossing_problem("weighted", (0.6, 0.4)), SolverProfile("highs", time_limit_s=30.0)).extras["watchdog"]

@@ -94,6 +94,7 @@ def cmd_schedule(args) -> int:
 
     scenario = _load(args)
     profile = load_profile(args.solver)
+    _warm_watchdog(profile.solver)
     if args.scheduler is not None:  # the windows solver's tasks on a running Dask cluster
         import dataclasses
 
@@ -168,9 +169,20 @@ def cmd_verify(args) -> int:
 MAX_SEED_COUNT = 10_000
 
 
+def _warm_watchdog(*solvers: str) -> None:
+    """Start the forkserver of the watched solves while the command builds its problem
+    (uamopt/solvers/watchdog.py): the first solve then does not spend its limit on imports."""
+    from uamopt.solvers import SOLVERS
+    from uamopt.solvers.watchdog import WATCHED, warm
+
+    if any(s in WATCHED or s not in SOLVERS for s in solvers):  # a profile's path: it may name one
+        warm()
+
+
 def cmd_bench(args) -> int:
     from uamopt.experiments.benchmark import cmd_bench as bench
 
+    _warm_watchdog(*(args.solver or ["highs"]))
     if args.seeds and len(args.seeds) == 1 and args.seeds[0] > MAX_SEED_COUNT:
         raise UamoptError(f"--seeds {args.seeds[0]} asks for more than {MAX_SEED_COUNT:,} runs per profile", "--seeds",
                           "give a count up to that (--seeds 3 runs seeds 0, 1, 2) or list the seeds (--seeds 0 7)")

@@ -124,7 +124,9 @@ def connect(scheduler: str | None, workers: int | None, tasks: int, scratch: str
         address = reach_scheduler(scheduler)
         logging.getLogger("distributed").setLevel(logging.ERROR)
         try:
-            return Client(address, timeout=CONNECT_TIMEOUT_S), None
+            client = Client(address, timeout=CONNECT_TIMEOUT_S)
+            warm_workers(client)
+            return client, None
         except Exception as exc:  # noqa: BLE001 - OSError, TimeoutError: something listens there, not a scheduler
             failure = error_line(exc)
         # the half-made Client sits in a reference cycle; collected later, at an allocation inside the
@@ -149,7 +151,10 @@ def connect(scheduler: str | None, workers: int | None, tasks: int, scratch: str
     try:
         # every temporary file of the cluster in ``scratch``, removed afterwards even where a worker
         # was stopped mid-task; worker logs muted (a task's error is in its row)
-        with dask.config.set({"temporary-directory": scratch}):
+        # workers not daemonic: a daemonic process may not start children, and an exact solve in a
+        # sweep's case runs in a child its time limit can end (uamopt/solvers/watchdog.py); the
+        # cluster's close still ends them
+        with dask.config.set({"temporary-directory": scratch, "distributed.worker.daemon": False}):
             cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, host="127.0.0.1",
                                    dashboard_address="127.0.0.1:0",  # a free loopback port
                                    silence_logs=logging.CRITICAL, env={"TMPDIR": scratch})
@@ -162,4 +167,17 @@ def connect(scheduler: str | None, workers: int | None, tasks: int, scratch: str
         if callable(previous_term):
             previous_term(signal.SIGTERM, None)  # raises Terminated (uamopt.interrupts)
         os.kill(os.getpid(), signal.SIGTERM)  # the default action: end the process
-    return Client(cluster), cluster
+    client = Client(cluster)
+    warm_workers(client)
+    return client, cluster
+
+
+def warm_workers(client) -> None:
+    """Start each worker's forkserver now (uamopt/solvers/watchdog.py), so that its first watched solve
+    does not spend its time limit importing the solver libraries (seconds at load 8)."""
+    from uamopt.solvers.watchdog import warm
+
+    try:
+        client.run(warm)
+    except Exception:  # noqa: BLE001 - a worker that cannot: its first solve starts the forkserver itself
+        pass
