@@ -35,10 +35,13 @@ def quiet_resource_tracker() -> None:
 SCHEMES = ("tcp", "tls", "ws", "wss", "ucx")
 
 
-def scheduler_address(scheduler: str) -> tuple[str, str, int]:
+def scheduler_address(scheduler: str, in_process: bool = False) -> tuple[str, str, int]:
     """``--scheduler`` as Dask takes it, ``(address, host, port)``: ``SCHEME://HOST:PORT`` with a
     scheme of :data:`SCHEMES` (``HOST:PORT`` is tcp), a host and a port in 1-65535, nothing else
-    (no path, no spaces). Else one :class:`UamoptError` naming the option, before anything runs.
+    (no path, no spaces); with ``in_process``, also an ``inproc://`` address of a cluster in this
+    process (a notebook's ``LocalCluster(processes=False)`` handed to ``ua.sweep``: host "" and port 0;
+    never from the command line, whose new process holds no cluster). Else one :class:`UamoptError` naming the
+    option, before anything runs.
 
     >>> scheduler_address("127.0.0.1:8786")
     ('tcp://127.0.0.1:8786', '127.0.0.1', 8786)
@@ -48,6 +51,9 @@ def scheduler_address(scheduler: str) -> tuple[str, str, int]:
     from uamopt.bounds import shown
 
     address = scheduler if "://" in scheduler else f"tcp://{scheduler}"
+    if in_process and address.startswith("inproc://") and len(address) > 9 \
+            and all(c.isprintable() and not c.isspace() for c in address):
+        return address, "", 0  # a cluster in this very process (LocalCluster(processes=False)): no host, no port
     try:
         parts = urlsplit(address)
         host, port = parts.hostname, parts.port
@@ -62,7 +68,7 @@ def scheduler_address(scheduler: str) -> tuple[str, str, int]:
     return address, str(host), int(port)
 
 
-def reach_scheduler(scheduler: str) -> str:
+def reach_scheduler(scheduler: str, in_process: bool = False) -> str:
     """The address of ``scheduler`` (:func:`scheduler_address`) once a Dask scheduler answers there
     within :data:`CONNECT_TIMEOUT_S`: a TCP connection (refused at once where nobody listens) and,
     for ``tcp://``, Dask's handshake (a server that accepts and stays silent held distributed's
@@ -70,7 +76,9 @@ def reach_scheduler(scheduler: str) -> str:
     command says so before its work and no half-made Dask client is left behind."""
     import socket
 
-    address, host, port = scheduler_address(scheduler)
+    address, host, port = scheduler_address(scheduler, in_process)
+    if address.startswith("inproc://"):  # in this process: the client's own connection says
+        return address
     try:
         if not address.startswith("ucx://"):  # ucx is not TCP: the client's own connection says
             socket.create_connection((host, port), timeout=CONNECT_TIMEOUT_S).close()
@@ -121,7 +129,7 @@ def connect(scheduler: str | None, workers: int | None, tasks: int, scratch: str
     from distributed import Client, LocalCluster
 
     if scheduler:
-        address = reach_scheduler(scheduler)
+        address = reach_scheduler(scheduler, in_process=True)
         logging.getLogger("distributed").setLevel(logging.ERROR)
         try:
             client = Client(address, timeout=CONNECT_TIMEOUT_S)
