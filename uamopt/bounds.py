@@ -157,7 +157,8 @@ def read_json(path, what: str, source: str, fix: str):
     try:
         return json.loads(Path(path).read_text(encoding="utf-8-sig"))
     except json.JSONDecodeError as exc:
-        raise InputFileError(f"malformed JSON: {exc.msg} at line {exc.lineno} column {exc.colno}", source,
+        # json's "Unterminated string starting at" ends in "at" already
+        raise InputFileError(f"malformed JSON: {exc.msg.removesuffix(' at')} at line {exc.lineno} column {exc.colno}", source,
                              "fix the syntax") from None
     except UnicodeDecodeError:
         raise InputFileError(f"{what} is not UTF-8 text", source, "save it as UTF-8 JSON") from None
