@@ -132,9 +132,7 @@ def connect(scheduler: str | None, workers: int | None, tasks: int, scratch: str
         address = reach_scheduler(scheduler, in_process=True)
         logging.getLogger("distributed").setLevel(logging.ERROR)
         try:
-            client = Client(address, timeout=CONNECT_TIMEOUT_S)
-            warm_workers(client)
-            return client, None
+            return Client(address, timeout=CONNECT_TIMEOUT_S), None
         except Exception as exc:  # noqa: BLE001 - OSError, TimeoutError: something listens there, not a scheduler
             failure = error_line(exc)
         # the half-made Client sits in a reference cycle; collected later, at an allocation inside the
@@ -175,17 +173,5 @@ def connect(scheduler: str | None, workers: int | None, tasks: int, scratch: str
         if callable(previous_term):
             previous_term(signal.SIGTERM, None)  # raises Terminated (uamopt.interrupts)
         os.kill(os.getpid(), signal.SIGTERM)  # the default action: end the process
-    client = Client(cluster)
-    warm_workers(client)
-    return client, cluster
+    return Client(cluster), cluster
 
-
-def warm_workers(client) -> None:
-    """Start each worker's forkserver now (uamopt/solvers/watchdog.py), so that its first watched solve
-    does not spend its time limit importing the solver libraries (seconds at load 8)."""
-    from uamopt.solvers.watchdog import warm
-
-    try:
-        client.run(warm)
-    except Exception:  # noqa: BLE001 - a worker that cannot: its first solve starts the forkserver itself
-        pass

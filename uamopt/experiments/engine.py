@@ -188,6 +188,9 @@ def _sweep(spec: SweepSpec, folder: ResultsFolder, scheduler, workers):
         scratch = tempfile.mkdtemp(prefix="uamopt-dask-")  # the workers' scratch space, removed afterwards
         try:
             client, cluster = connect(scheduler, workers, len(todo), scratch)
+            from uamopt.solvers.watchdog import warm_workers
+
+            warm_workers(client)  # the cases' exact solves start without waiting for their imports
             try:
                 stats["set_aside"] = folder.start(spec, broken)
                 with Progress(len(todo), f"sweep {spec.name}", "cases") as progress:

@@ -180,6 +180,16 @@ def warm() -> None:
             pass
 
 
+def warm_workers(client) -> None:
+    """Start each Dask worker's forkserver now (:func:`warm`), so that its first watched solve does
+    not spend its time limit importing the solver libraries (seconds at load 8). The callers of
+    ``uamopt.cluster.connect`` (the windows solver, the sweep engine) call it."""
+    try:
+        client.run(warm)
+    except Exception:  # noqa: BLE001 - a worker that cannot: its first solve starts the forkserver itself
+        pass
+
+
 def why_not_isolated(profile: SolverProfile, extra) -> str | None:
     """Why a solve runs in this process (None: it runs in a watched child)."""
     if profile.solver not in WATCHED:

@@ -162,6 +162,7 @@ def solve(problem: SchedulingProblem, profile: SolverProfile) -> Schedule:
     from uamopt.cluster import connect
     from uamopt.solvers import lns
     from uamopt.solvers.warmstart import no_worse, reduced, warm_start
+    from uamopt.solvers.watchdog import warm_workers
 
     require("distributed", extra="sweep", what="the windows solver (Dask)")
     o = profile.option
@@ -175,6 +176,7 @@ def solve(problem: SchedulingProblem, profile: SolverProfile) -> Schedule:
         1.0, WINDOWS_SHARE * profile.time_limit_s * min(workers, len(windows)) / len(windows))
     subs = [window_problem(problem, index) for index in windows]
     client, cluster = connect(o("scheduler") or None, workers, len(windows))
+    warm_workers(client)
     try:
         # the sub-problems go to the workers as data, not inside the task graph (13 MB at 10,000 flights:
         # Dask warned of a large graph)
