@@ -167,15 +167,34 @@ def _context():
     return _CONTEXT[0]
 
 
+def _ensure_server() -> None:
+    """Start the forkserver (if it is not running) with SIGINT ignored: an ignored signal stays
+    ignored across exec and Python then leaves it so, so a Ctrl-C that reaches the whole process
+    group while the server imports the solver libraries prints no traceback there
+    (multiprocessing ignores SIGINT in it only after those imports). SIGINT is blocked meanwhile in
+    this process, so a Ctrl-C to it during the start is held (Linux queues a blocked signal even
+    while it is ignored) and acted on once the handler is back."""
+    from multiprocessing import forkserver
+
+    _context()
+    if threading.current_thread() is not threading.main_thread():
+        forkserver.ensure_running()
+        return
+    mask = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    handler = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        forkserver.ensure_running()
+    finally:
+        signal.signal(signal.SIGINT, handler if handler is not None else signal.SIG_DFL)
+        signal.pthread_sigmask(signal.SIG_SETMASK, mask)
+
+
 def warm() -> None:
     """Start the forkserver now (it imports the solver libraries in the background), so that the
     first watched solve does not wait for it. Harmless where it cannot start."""
     if "forkserver" in mp.get_all_start_methods() and not mp.current_process().daemon:
         try:
-            from multiprocessing import forkserver
-
-            _context()
-            forkserver.ensure_running()
+            _ensure_server()
         except Exception:  # noqa: BLE001 - the solve will say why, or run in this process
             pass
 
@@ -263,6 +282,7 @@ def _run_child(problem, profile, extra, body) -> Schedule:
     bound: tuple[float, str] | None = None
     answer: tuple | None = None
     try:
+        _ensure_server()
         with _main_not_reimported():
             child.start()
         channel.close()
