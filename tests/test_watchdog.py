@@ -247,3 +247,27 @@ def test_a_solve_on_a_worker_of_uamopts_cluster_is_watched():
     finally:
         client.close()
         cluster.close()
+
+
+def test_a_tmpdir_too_long_for_a_unix_socket_still_gets_a_watched_solve(tmp_path):
+    """CI's checkout put pytest's folders deep enough that the forkserver's socket path passed the
+    108 bytes a Unix socket address may hold ("AF_UNIX path too long", a traceback from `schedule`).
+    The socket then goes in a short folder of its own, which is gone when the process exits."""
+    deep = tmp_path / ("d" * 60) / ("e" * 60)
+    deep.mkdir(parents=True)
+    script = tmp_path / "run.py"
+    script.write_text(textwrap.dedent("""
+        from multiprocessing import forkserver
+        from instances import crossing_problem
+        from uamopt.solvers import SolverProfile, solve
+        s = solve(crossing_problem("weighted", (0.6, 0.4)), SolverProfile("highs", time_limit_s=600.0))
+        print(s.status, s.extras["watchdog"], forkserver._forkserver._forkserver_address, sep="|")
+    """))
+    env = {**os.environ, "PYTHONPATH": os.path.dirname(__file__), "TMPDIR": str(deep)}
+    done = subprocess.run([sys.executable, str(script)], env=env, capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0 and "Traceback" not in done.stderr, done.stderr
+    status, where, address = done.stdout.strip().splitlines()[-1].split("|")
+    assert (status, where) == ("optimal", "child process")
+    assert len(os.fsencode(address)) < 108 and not address.startswith(str(deep))
+    assert not os.path.exists(os.path.dirname(address))  # removed at exit
+    assert list(deep.iterdir()) == []

@@ -167,6 +167,50 @@ def _context():
     return _CONTEXT[0]
 
 
+#: sun_path holds 108 bytes with its NUL; the forkserver's socket is ``<dir>/listener-XXXXXXXX``
+_SUN_PATH_MAX = 107
+_LISTENER_NAME = len("/listener-") + 8
+
+
+@contextmanager
+def _socket_dir_short_enough() -> Iterator[None]:
+    """The forkserver listens on a Unix socket in multiprocessing's temporary folder, made under
+    ``$TMPDIR``; a long ``$TMPDIR`` (a CI checkout's pytest folder, a deep home directory) makes
+    that path longer than a Unix socket address may be, and the server cannot start
+    ("AF_UNIX path too long"). Then the socket goes in a short folder of its own under ``/tmp``
+    (or ``/dev/shm``, ``/var/tmp``), removed when this process exits, while the server starts."""
+    import tempfile
+    from multiprocessing import process, util
+
+    config = process.current_process()._config  # where multiprocessing.util.get_temp_dir keeps it
+    current = config.get("tempdir") or tempfile.gettempdir()
+    if len(os.fsencode(current)) + len("/pymp-XXXXXXXX") + _LISTENER_NAME <= _SUN_PATH_MAX:
+        yield
+        return
+    for base in ("/tmp", "/dev/shm", "/var/tmp"):
+        try:
+            short = tempfile.mkdtemp(prefix="uamopt-", dir=base)
+            break
+        except OSError:
+            continue
+    else:
+        raise OSError(f"no folder short enough for the solver watchdog's socket: $TMPDIR ({current}) is "
+                      "too long for a Unix socket address and /tmp, /dev/shm, /var/tmp are not writable")
+    import shutil
+
+    util.Finalize(None, shutil.rmtree, args=(short, True), exitpriority=-100)
+    had = "tempdir" in config
+    saved = config.get("tempdir")
+    config["tempdir"] = short
+    try:
+        yield
+    finally:
+        if had:
+            config["tempdir"] = saved
+        else:
+            config.pop("tempdir", None)
+
+
 def _ensure_server() -> None:
     """Start the forkserver (if it is not running) with SIGINT ignored: an ignored signal stays
     ignored across exec and Python then leaves it so, so a Ctrl-C that reaches the whole process
@@ -178,12 +222,14 @@ def _ensure_server() -> None:
 
     _context()
     if threading.current_thread() is not threading.main_thread():
-        forkserver.ensure_running()
+        with _socket_dir_short_enough():
+            forkserver.ensure_running()
         return
     mask = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
     handler = signal.signal(signal.SIGINT, signal.SIG_IGN)
     try:
-        forkserver.ensure_running()
+        with _socket_dir_short_enough():
+            forkserver.ensure_running()
     finally:
         signal.signal(signal.SIGINT, handler if handler is not None else signal.SIG_DFL)
         signal.pthread_sigmask(signal.SIG_SETMASK, mask)
@@ -263,6 +309,13 @@ def run(problem: SchedulingProblem, profile: SolverProfile, extra, body) -> Sche
         schedule = body(problem, profile, extra)
         if profile.solver in WATCHED:
             schedule.extras.setdefault("watchdog", why)
+        return schedule
+    try:
+        _ensure_server()
+    except OSError as exc:  # no socket can be made: an unwatched solve beats none
+        schedule = body(problem, profile, extra)
+        schedule.extras.setdefault("watchdog", f"the watchdog's process server could not start ({exc}): the solve "
+                                   "ran in this process, its time limit unguarded")
         return schedule
     return _run_child(problem, profile, extra, body)
 
