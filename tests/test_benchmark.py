@@ -68,7 +68,7 @@ def test_bench_markdown_and_progress(paper_bench):
     table = pd.read_csv(out / "bench.csv")
     best = table["objective"].min()
     assert "## By solver profile" in text and "best known objective" in text and f"{best:.6g}" in text
-    section = text.split("## By solver profile")[1].split("## Runs")[0]
+    section = text.split("## By solver profile")[1].split("\n## ")[0]
     summary = [row for row in section.splitlines() if row.startswith("| paper_case | ")]
     assert [row.split(" | ")[1] for row in summary] == ["greedy", "soa", "highs"]
     assert [row.split(" | ")[2] for row in summary] == ["delay grid 10 s, heuristic"] * 2 + ["continuous"]  # model
@@ -188,3 +188,13 @@ def test_progress_bar_on_a_terminal():
     os.close(master)
     assert "sweep demo" in output and "/3 [" in output and "\r" in output  # a bar redrawn in place
     assert "- started" not in output  # no plain lines on a terminal
+
+
+def test_a_repeated_solver_option_adds_profiles(tmp_path):
+    """`--solver highs --solver greedy` ran greedy alone (argparse kept the last list)."""
+    from uamopt.cli import main
+
+    airland1 = Path(__file__).parent / "data" / "airland" / "airland1.txt"
+    assert main(["bench", str(airland1), "--solver", "highs", "--solver", "greedy", "--time-limit", "60",
+                 "--out", str(tmp_path / "b")]) == 0
+    assert list(pd.read_csv(tmp_path / "b" / "bench.csv")["profile"]) == ["highs", "greedy"]

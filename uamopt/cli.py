@@ -240,7 +240,7 @@ def build_parser() -> argparse.ArgumentParser:
     bench = sub.add_parser("bench", help="benchmark solver profiles × seeds on scenarios: bench.csv, bench.md",
                            description="benchmark solver profiles × seeds on scenarios: bench.csv, bench.md")
     bench.add_argument("scenario", nargs="+", help="scenario TOML files, or OR-Library airland .txt files")
-    bench.add_argument("--solver", nargs="+", required=True, metavar="PROFILE", help="solver profiles")
+    bench.add_argument("--solver", nargs="+", action="extend", required=True, metavar="PROFILE", help="solver profiles")
     bench.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="override keys of every scenario")
     bench.add_argument("--out", default="out/bench", help="output folder (default: out/bench)")
     bench.add_argument("--seeds", nargs="+", type=_seed, metavar="SEED",

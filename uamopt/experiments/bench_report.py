@@ -8,6 +8,9 @@ profile (``performance_profile.png``): for each profile the fraction of instance
 median objective lies within a factor τ of the best profile's, with the ratio taken on the
 objective's distance to the best, r = 1 + (obj − best) / |best| (the objectives of Eq. 20 are
 negative, so a plain quotient would not order them); a run without a solution has r = ∞.
+Then *Incumbent and bound over time* (:func:`over_time`, ``convergence.png``): from each run's
+trace, the seconds to its first incumbent, to within 1 % of the best known objective and to its
+last bound gain, and its primal integral.
 
 With ``--against FILE`` (uamopt/experiments/results.py) a section *Against FILE* follows the
 instances: first, loudly, the contradictions (a bound of the file above a verified objective of
@@ -25,7 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
-from uamopt.plotting.benchmark import distance, plot_performance_profile
+from uamopt.plotting.benchmark import distance, plot_convergence, plot_performance_profile, run_trace, step_values
 
 TINY = 1e-9  # a value below this (rounding noise, e.g. a gap of 1.3e-15) is printed as 0
 
@@ -103,7 +106,55 @@ def summary(table):
 
 #: bench.csv columns the Runs table of bench.md leaves out (said elsewhere, or in the Against section)
 NOT_IN_RUNS = ("error", "objective_kind", "plan_seed", "scenario", "set", "best_known_objective", "best_known_bound",
-               "to_best_objective", "to_best_bound")
+               "to_best_objective", "to_best_bound", "trace")
+
+#: a run is "within 1 %" once its incumbent is at most this far above the best known objective
+TARGET_DISTANCE = 0.01
+
+
+def primal_gap(value: float, best: float) -> float:
+    """Berthold's primal gap of an incumbent against the best known objective: 1 without an
+    incumbent or when the two differ in sign, else |value − best| / max(|value|, |best|) (0 when both are 0)."""
+    if not math.isfinite(value) or not math.isfinite(best) or value * best < 0:
+        return 1.0
+    scale = max(abs(value), abs(best))
+    return 0.0 if scale == 0 else min(1.0, abs(value - best) / scale)
+
+
+def over_time(table):
+    """One row per run with a trace: seconds to its first incumbent, to an incumbent within
+    ``TARGET_DISTANCE`` of the instance's best known objective, to its last bound improvement, and
+    its primal integral (Berthold, "Measuring the impact of primal heuristics", Oper. Res. Lett.
+    41(6), 2013): ∫ primal gap dt from 0 to the run's time limit (a run that ended sooner keeps its
+    answer's gap to the limit, so a quick heuristic is not rewarded for stopping), in seconds (0:
+    the best known at once; the time limit: nothing useful)."""
+    import pandas as pd
+
+    best, _ = best_known(table)
+    rows = []
+    for run in table.itertuples(index=False):
+        trace = run_trace(getattr(run, "trace", None))
+        if not trace:
+            continue
+        ref = best.get(run.instance, math.nan)
+        end = float(trace[-1][0])
+        times, values = step_values(trace, 1)
+        bound_times, bounds = step_values(trace, 2)
+        gains = bound_times[np.concatenate([[True], np.diff(bounds) > 0])] if len(bounds) else bound_times
+        near = [t for t, v in zip(times, values, strict=True) if math.isfinite(ref) and distance(v, ref) <= TARGET_DISTANCE]
+        integral, before, gap = 0.0, 0.0, 1.0
+        for t, v in zip(times, values, strict=True):
+            integral += gap * (min(t, end) - before)
+            before, gap = min(t, end), primal_gap(v, ref)
+        horizon = max(end, float(run.time_limit_s)) if math.isfinite(float(run.time_limit_s)) else end
+        integral += gap * (horizon - before)
+        rows.append({"instance": run.instance, "profile": run.profile, "seed": run.seed,
+                     "first incumbent s": float(times[0]) if len(times) else math.nan,
+                     "within 1 % s": float(near[0]) if near else math.nan,
+                     "last bound gain s": float(gains[-1]) if len(gains) else math.nan,
+                     "primal integral s": integral, "solve s": end, "gap": run.gap})
+    return pd.DataFrame(rows, columns=["instance", "profile", "seed", "first incumbent s", "within 1 % s",
+                                       "last bound gain s", "primal integral s", "solve s", "gap"])
 
 
 def against_section(comparison) -> list[str]:
@@ -177,6 +228,16 @@ def bench_markdown(table, comparison=None) -> str:
                                         "solve s median", "build s median"])
     if table["instance"].nunique() > 1:
         lines += ["", "## Performance profile", "", "![performance profile](performance_profile.png)"]
+    progress = over_time(table) if "trace" in table else None
+    if progress is not None and len(progress):
+        lines += ["", "## Incumbent and bound over time", "",
+                  "![incumbent and bound over time](convergence.png)", "",
+                  "From each run's trace (bench.csv `trace`: `[seconds, best objective, best bound]` each time one "
+                  "improved). `within 1 % s`: the first time its incumbent was within 1 % of the best known objective "
+                  "above; `primal integral s`: ∫ primal gap dt from 0 to its time limit (Berthold 2013; the gap is 1 "
+                  "without an incumbent, and a run that ended sooner keeps its answer's gap), smaller is better; "
+                  "empty: never.", "",
+                  *_markdown(progress, list(progress.columns))]
     lines += ["", "## Runs", "", *_markdown(table, [c for c in table.columns if c not in NOT_IN_RUNS])]
     errors = table[table["error"].notna()]
     if len(errors):
@@ -185,7 +246,7 @@ def bench_markdown(table, comparison=None) -> str:
 
 
 def write_bench(out: str | Path, table, comparison=None) -> str:
-    """Write bench.csv, bench.md (and performance_profile.png) into ``out``, all or nothing;
+    """Write bench.csv, bench.md (and performance_profile.png, convergence.png) into ``out``, all or nothing;
     ``comparison`` (uamopt.experiments.results.compare): the Against section of bench.md."""
     from uamopt.outputs import staged_output
     from uamopt.plotting.output import save
@@ -196,4 +257,6 @@ def write_bench(out: str | Path, table, comparison=None) -> str:
         (stage / "bench.md").write_text(text, encoding="utf-8")
         if table["instance"].nunique() > 1:
             save(plot_performance_profile(table), stage / "performance_profile.png")
+        if "trace" in table and len(over_time(table)):
+            save(plot_convergence(table), stage / "convergence.png")
     return text

@@ -15,11 +15,15 @@ building, data transfer). Before the timed runs each solver runs once, untimed, 
 seed of its generated flight plan; empty for an airland file or a ``--flights`` plan),
 ``scenario`` (the file) and ``set`` (the overrides, a JSON list), so that a row can be run again
 and recorded in a results file (``--against FILE --update``, uamopt/experiments/results.py).
+``trace`` (a JSON list) is the run's progress: ``[seconds, best objective, best bound]`` each time
+either improved (null until the first), ending at the answer (uamopt.solvers.watchdog.trace_of;
+a heuristic's is its answer alone): bench.md's *over time* section and ``convergence.png``.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import json
 import math
 import time
 from pathlib import Path
@@ -32,7 +36,7 @@ from uamopt.progress import Progress
 COLUMNS = ["instance", "flights", "aircraft", "conflicting_pairs", "solver", "profile", "seed", "threads", "time_limit_s",
            "objective_kind", "status", "model", "objective", "bound", "gap", "operated", "cancelled", "total_delay_s",
            "avg_delay_s", "wall_seconds", "solve_seconds", "build_seconds", "verified", "error", "plan_seed", "scenario",
-           "set"]
+           "set", "trace"]
 
 
 def instance_name(scenario, overrides=()) -> str:
@@ -163,7 +167,8 @@ def solve_row(name: str, problem, profile, seed: int) -> dict:
         wall = time.perf_counter() - t0
         row.update(schedule_row(problem, schedule, wall))
         row.update(wall_seconds=wall, solve_seconds=schedule.solve_seconds,
-                   build_seconds=max(0.0, wall - schedule.solve_seconds))
+                   build_seconds=max(0.0, wall - schedule.solve_seconds),
+                   trace=json.dumps(schedule.extras.get("trace", [])))
     except Exception as exc:  # noqa: BLE001 - one failing solver must not end a benchmark
         row.update(status="error", error=error_line(exc), wall_seconds=time.perf_counter() - t0)
     row.pop("seconds", None)
@@ -201,8 +206,6 @@ def benchmark(problem_or_scenarios, solvers, seeds=None, time_limit_s: float | N
         table = benchmark("models/paper_case.toml", ["greedy", "soa", "highs"], seeds=[0, 1, 2], time_limit_s=30)
         table.groupby("profile")["objective"].median()
     """
-    import json
-
     import pandas as pd
 
     seeds = _checked_seeds(seeds)

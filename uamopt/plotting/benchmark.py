@@ -56,3 +56,74 @@ def plot_performance_profile(table, ax=None):
     ax.grid(alpha=0.3)
     ax.legend(loc="lower right")
     return fig
+
+
+# --- incumbent and bound over time ------------------------------------------------------------------
+
+#: instances drawn in convergence.png at most (the first ones of the table; bench.md lists every run)
+MAX_CONVERGENCE_PANELS = 12
+
+
+def run_trace(value) -> list[list]:
+    """A bench.csv ``trace`` cell (a JSON list of ``[seconds, objective, bound]``) as a list; [] when empty."""
+    import json
+
+    if value is None or (isinstance(value, float) and math.isnan(value)) or value == "":
+        return []
+    return json.loads(value) if isinstance(value, str) else list(value)
+
+
+def step_values(trace: list[list], column: int) -> tuple[np.ndarray, np.ndarray]:
+    """(times, values) of one column of a trace (1: objective, 2: bound), points without a value left out."""
+    points = [(t[0], t[column]) for t in trace if t[column] is not None]
+    if not points:
+        return np.zeros(0), np.zeros(0)
+    times, values = zip(*points, strict=True)
+    return np.asarray(times, dtype=float), np.asarray(values, dtype=float)
+
+
+def plot_convergence(table, ax=None):
+    """Incumbent (solid) and bound (dashed) over the solve's own seconds, one panel per instance
+    (the first :data:`MAX_CONVERGENCE_PANELS`), one colour per solver profile, one line per seed.
+    ``ax`` as in :mod:`uamopt.plotting` (None, a Figure, or a sequence of Axes); returns the Figure."""
+    from uamopt.plotting.layout import panels
+
+    instances = list(dict.fromkeys(table["instance"]))[:MAX_CONVERGENCE_PANELS]
+    columns = min(3, len(instances))
+    rows = -(-len(instances) // columns)
+
+    def layout(page):
+        page.set_layout_engine("constrained")
+        return list(np.ravel(page.subplots(rows, columns, squeeze=False)))[:len(instances)]
+
+    fig, axes, page = panels(ax, len(instances), layout, (4.6 * columns, 3.4 * rows))
+    colours = {p: f"C{i % 10}" for i, p in enumerate(dict.fromkeys(table["profile"]))}
+    for axis, instance in zip(axes, instances, strict=False):
+        labelled: set = set()
+        answers = []  # each run's final objective and bound: the y range shows them, not a first poor incumbent
+        for run in table[table["instance"] == instance].itertuples(index=False):
+            trace = run_trace(getattr(run, "trace", None))
+            colour = colours[run.profile]
+            for column, style, what in ((1, "-", "incumbent"), (2, "--", "bound")):
+                times, values = step_values(trace, column)
+                if not len(times):
+                    continue
+                label = f"{run.profile} {what}" if (run.profile, what) not in labelled else None
+                labelled.add((run.profile, what))
+                axis.step(times, values, where="post", linestyle=style, color=colour, linewidth=1.4, label=label)
+                axis.plot(times[-1:], values[-1:], "o" if column == 1 else "v", color=colour, markersize=3.5)
+                answers.append(float(values[-1]))
+        if answers:
+            low, high = min(answers), max(answers)
+            span = max(high - low, 1e-6 * max(1.0, abs(high)))
+            axis.set_ylim(low - 0.1 * span, high + 0.8 * span)
+        axis.set_title(str(instance), fontsize=9)
+        axis.set_xlabel("solve seconds")
+        axis.set_ylabel("objective")
+        axis.grid(alpha=0.3)
+        if labelled:
+            axis.legend(fontsize=7, loc="best")
+    if page is not None:
+        page.suptitle("Incumbent (solid) and bound (dashed) over time; markers: each run's answer "
+                      "(the axis is cut above the answers)", fontsize=10)
+    return fig

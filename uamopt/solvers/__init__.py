@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import dataclasses
 import importlib
+import math
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -208,6 +209,11 @@ def solve(problem: SchedulingProblem, profile: SolverProfile | str, *, extra=Non
         schedule.extras.setdefault("bound_source", "the separable bound (every flight at its own best choice)")
         schedule = dataclasses.replace(schedule, bound=bound,
                                        gap=abs(schedule.objective - bound) / max(abs(schedule.objective), 1e-10))
+    # the progress over time (watchdog.trace_of; a heuristic's is its answer alone), ending at the answer
+    final = [round(float(schedule.solve_seconds), 3),
+             float(schedule.objective) if schedule.status != "infeasible" and schedule.objective is not None else None,
+             float(schedule.bound) if schedule.bound is not None and math.isfinite(schedule.bound) else None]
+    schedule.extras["trace"] = [*schedule.extras.get("trace", []), final]
     return schedule
 
 

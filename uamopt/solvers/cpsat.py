@@ -47,6 +47,7 @@ from uamopt.errors import UamoptError
 from uamopt.interrupts import stopping
 from uamopt.schedule.flights import TIME_TOL_S
 from uamopt.schedule.model import Schedule, SchedulingProblem, Status, make_schedule
+from uamopt.solvers.watchdog import report_incumbent, watched
 
 if TYPE_CHECKING:
     from ortools.sat.python import cp_model
@@ -333,6 +334,20 @@ def _solver(profile: SolverProfile, options: dict, limit_s: float):
     return cp_solver(limit_s, profile.threads, profile.seed, options, f"profile {profile.name or 'cpsat'}")
 
 
+def _reporter(problem: SchedulingProblem, operate, delay, unit_s: float):
+    """A CP-SAT solution callback passing each incumbent on as a schedule (watchdog.report_incumbent:
+    a watched child's parent, or the trace of a solve in this process; the receiver checks them)."""
+    from ortools.sat.python import cp_model
+
+    class Reporter(cp_model.CpSolverSolutionCallback):
+        def on_solution_callback(self) -> None:
+            operated = np.array([self.boolean_value(v) for v in operate], dtype=bool)
+            delay_s = np.array([self.value(v) for v in delay], dtype=float) * unit_s
+            report_incumbent(problem, operated, np.where(operated, delay_s, 0.0), "CP-SAT's incumbent")
+
+    return Reporter()
+
+
 def solve(problem: SchedulingProblem, profile: SolverProfile, extra=None) -> Schedule:
     """Solve the discretised model with CP-SAT; status optimal | time_limit | infeasible, from CP-SAT's
     own termination (OPTIMAL: proved on the u-lattice model; FEASIBLE: stopped by the time limit,
@@ -369,7 +384,7 @@ def solve(problem: SchedulingProblem, profile: SolverProfile, extra=None) -> Sch
     build_s = time.perf_counter() - t0  # model, warm start and hints
     solver = _solver(profile, options, max(0.05, profile.time_limit_s - build_s))  # the limit covers the build too
     with stopping(solver.stop_search):  # Ctrl-C and SIGTERM stop the search at once
-        code = solver.solve(model)
+        code = solver.solve(model, _reporter(problem, operate, delay, unit_s)) if watched(problem) else solver.solve(model)
     seconds = time.perf_counter() - t0
     n = problem.n_flights
     extras = {"termination": solver.status_name(code), "time_unit_s": unit_s, "objective_scale": how,

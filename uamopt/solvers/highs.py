@@ -23,12 +23,12 @@ from uamopt.errors import UamoptError
 from uamopt.interrupts import stopping
 
 
-def interrupt_at(highs, deadline: float, grace_s: float = 0.05, on_bound=None) -> list:
+def interrupt_at(highs, deadline: float, grace_s: float = 0.05, on_bound=None, on_solution=None) -> list:
     """Make ``highs`` (a ``highspy.Highs``) stop once ``time.perf_counter()`` passes ``deadline``.
     Returns a list that is non-empty once it has stopped HiGHS (HiGHS then reports "interrupted by
     user", which Pyomo reads as an unknown termination: it is the time limit). ``on_bound(value)``,
     if given, hears the MIP's dual bound at each of HiGHS's MIP callbacks (a watched child passes it
-    on: uamopt.solvers.watchdog)."""
+    on: uamopt.solvers.watchdog); ``on_solution(x)`` each improving MIP solution's column values."""
     fired: list = []
 
     def stop(event) -> None:
@@ -42,6 +42,13 @@ def interrupt_at(highs, deadline: float, grace_s: float = 0.05, on_bound=None) -
 
     for callback in (highs.cbSimplexInterrupt, highs.cbIpmInterrupt, highs.cbMipInterrupt):
         callback.subscribe(stop)
+    if on_solution is not None:
+        def improved(event) -> None:
+            solution = getattr(getattr(event, "data_out", None), "mip_solution", None)
+            if solution is not None:
+                on_solution(np.asarray(solution, dtype=float))
+
+        highs.cbMipImprovingSolution.subscribe(improved)
     return fired
 
 

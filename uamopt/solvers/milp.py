@@ -60,7 +60,7 @@ from uamopt.interrupts import quiet_on_interrupt, stopping
 from uamopt.schedule.flights import TIME_TOL_S
 from uamopt.schedule.model import Schedule, SchedulingProblem, Status, make_schedule
 from uamopt.solvers.highs import interrupt_at, start_solution
-from uamopt.solvers.watchdog import report_bound
+from uamopt.solvers.watchdog import report_bound, report_incumbent, watched
 
 if TYPE_CHECKING:
     from uamopt.solvers import SolverProfile
@@ -442,7 +442,8 @@ def solve(problem: SchedulingProblem, profile: SolverProfile, extra=None) -> Sch
     stopped: list = []
     if getattr(solver, "_solver_model", None) is not None:  # pyomo 6.10's persistent HiGHS object
         stopped = interrupt_at(solver._solver_model, t0 + profile.time_limit_s,  # where HiGHS listens (solvers/highs.py)
-                               on_bound=lambda b: report_bound(problem, b, "HiGHS's dual bound"))
+                               on_bound=lambda b: report_bound(problem, b, "HiGHS's dual bound"),
+                               on_solution=_incumbent_reporter(problem, m, solver))
     left = profile.time_limit_s - (time.perf_counter() - t0)
     if left <= 0.05:
         return _start_only(problem, profile, start, t0, f"the time limit ran out while building the MILP ({build_s:.1f} s)")
@@ -545,6 +546,31 @@ def _own_thread_pool(solver) -> None:
     highs = getattr(solver, "_solver_model", None)
     if highs is not None:
         highs.resetGlobalScheduler(True)
+
+
+def _incumbent_reporter(problem, m, solver):
+    """HiGHS's improving MIP solutions, passed on as schedules (watchdog.report_incumbent; the
+    parent checks them) when the solve is watched or traced; None otherwise or without the
+    persistent interface's column map."""
+    index = getattr(solver, "_pyomo_var_to_solver_var_map", None)
+    if not index or not watched(problem):
+        return None
+    n = problem.n_flights
+    try:
+        op_cols = np.array([index[id(m.operate[f])] for f in range(n)], dtype=np.int64)
+        delay_cols = np.array([index[id(m.delay[f])] for f in range(n)], dtype=np.int64)
+    except KeyError:
+        return None
+    upper = np.asarray(problem.delay_upper_s, dtype=float)
+
+    def report(x: np.ndarray) -> None:
+        if len(x) <= max(int(op_cols.max(initial=0)), int(delay_cols.max(initial=0))):
+            return
+        operated = x[op_cols] > 0.5
+        report_incumbent(problem, operated, np.where(operated, np.clip(x[delay_cols], 0.0, upper), 0.0),
+                         "HiGHS's incumbent")
+
+    return report
 
 
 def _set_mip_start(solver, values: dict) -> None:

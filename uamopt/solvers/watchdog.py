@@ -81,24 +81,50 @@ _LOCK = threading.Lock()  # CP-SAT calls back from its own threads
 _LAST_BOUND = [-math.inf, 0.0]  # the best bound sent, and when (bounds are sent at most once a second)
 
 
+_SINKS: dict[int, list] = {}  # id() of a problem solved in this process (unwatched) -> its reports, timed
+
+
 def watched(problem) -> bool:
-    """Whether reports about ``problem`` go anywhere (a watched child solving exactly this problem)."""
-    return _CHANNEL is not None and id(problem) == _TOP
+    """Whether reports about ``problem`` go anywhere: a watched child solving exactly this problem,
+    or an exact solve of it in this process, whose reports make its trace (:func:`trace_of`)."""
+    return (_CHANNEL is not None and id(problem) == _TOP) or id(problem) in _SINKS
 
 
-def _send(message: tuple) -> None:
+def _send(message: tuple, problem=None) -> None:
     with _LOCK:
+        if _CHANNEL is None:
+            sink = _SINKS.get(id(problem))
+            if sink is not None:
+                sink.append((time.monotonic(), message))
+            return
         try:
             _CHANNEL.send(message)
         except (OSError, ValueError):  # the parent is gone or closed the pipe: the lifeline ends us
             pass
 
 
+@contextmanager
+def _recorded(problem) -> Iterator[list]:
+    """The reports about ``problem`` made in this process while the block runs, as (time, message)
+    (nothing when another solve of the same object records already)."""
+    if id(problem) in _SINKS:
+        yield []
+        return
+    events: list = []
+    _SINKS[id(problem)] = events
+    _LAST_BOUND[:] = [-math.inf, 0.0]
+    try:
+        yield events
+    finally:
+        _SINKS.pop(id(problem), None)
+
+
 def report_incumbent(problem, operated: np.ndarray, delay_s: np.ndarray, source: str) -> None:
     """Tell the parent about a complete schedule of ``problem`` (feasible as far as the caller knows;
     the parent checks it before using it). A no-op outside a watched child or for another problem."""
     if watched(problem):
-        _send(("incumbent", np.asarray(operated, dtype=bool).copy(), np.asarray(delay_s, dtype=float).copy(), str(source)))
+        _send(("incumbent", np.asarray(operated, dtype=bool).copy(), np.asarray(delay_s, dtype=float).copy(), str(source)),
+              problem)
 
 
 def report_bound(problem, bound: float | None, source: str) -> None:
@@ -113,7 +139,7 @@ def report_bound(problem, bound: float | None, source: str) -> None:
     if bound > _LAST_BOUND[0]:
         _LAST_BOUND[0] = float(bound)
     _LAST_BOUND[1] = now
-    _send(("bound", float(bound), str(source)))
+    _send(("bound", float(bound), str(source)), problem)
 
 
 def _lifeline(conn) -> None:
@@ -182,7 +208,7 @@ def _socket_dir_short_enough() -> Iterator[None]:
     import tempfile
     from multiprocessing import process, util
 
-    config = process.current_process()._config  # where multiprocessing.util.get_temp_dir keeps it
+    config = process.current_process()._config  # type: ignore[attr-defined]  # where multiprocessing.util.get_temp_dir keeps it
     current = config.get("tempdir") or tempfile.gettempdir()
     if len(os.fsencode(current)) + len("/pymp-XXXXXXXX") + _LISTENER_NAME <= _SUN_PATH_MAX:
         yield
@@ -305,19 +331,57 @@ def run(problem: SchedulingProblem, profile: SolverProfile, extra, body) -> Sche
     """``body(problem, profile, extra)`` in a watched child process (module docstring), or in this
     process where that cannot be (the reason in ``extras["watchdog"]`` for a watched solver)."""
     why = why_not_isolated(profile, extra)
-    if why is not None:
+    if why is None:
+        try:
+            _ensure_server()
+        except OSError as exc:  # no socket can be made: an unwatched solve beats none
+            why = (f"the watchdog's process server could not start ({exc}): the solve ran in this process, "
+                   "its time limit unguarded")
+    if why is None:
+        return _run_child(problem, profile, extra, body)
+    if profile.solver not in WATCHED:
+        return body(problem, profile, extra)
+    t0 = time.monotonic()
+    with _recorded(problem) as events:
         schedule = body(problem, profile, extra)
-        if profile.solver in WATCHED:
-            schedule.extras.setdefault("watchdog", why)
-        return schedule
-    try:
-        _ensure_server()
-    except OSError as exc:  # no socket can be made: an unwatched solve beats none
-        schedule = body(problem, profile, extra)
-        schedule.extras.setdefault("watchdog", f"the watchdog's process server could not start ({exc}): the solve "
-                                   "ran in this process, its time limit unguarded")
-        return schedule
-    return _run_child(problem, profile, extra, body)
+    schedule.extras.setdefault("watchdog", why)
+    schedule.extras["trace"] = trace_of(problem, events, t0)
+    return schedule
+
+
+#: at most this many points in a trace (evenly thinned beyond)
+TRACE_POINTS = 400
+
+
+def trace_of(problem: SchedulingProblem, events: list, t0: float) -> list[list]:
+    """The solve's progress from its reports: ``[seconds, best objective, best bound]`` each time
+    one of them improved (None until the first). An incumbent counts only if the model's own
+    ``violations`` accept it; a bound as reported (every reported bound is valid for continuous
+    delays). :func:`uamopt.solvers.solve` appends the final answer's point."""
+    from uamopt.schedule.model import evaluate, violations
+
+    best, bound, points = math.inf, -math.inf, []
+    for at, message in events:
+        if message[0] == "incumbent":
+            operated, delay = message[1], message[2]
+            if len(operated) != problem.n_flights:
+                continue
+            value = float(evaluate(problem, operated, delay))
+            if value >= best - 1e-9 * (1.0 + abs(value)) or violations(problem, operated, delay):
+                continue
+            best = value
+        elif message[0] == "bound":
+            if not message[1] > bound:
+                continue
+            bound = float(message[1])
+        else:
+            continue
+        points.append([round(max(0.0, at - t0), 3), best if math.isfinite(best) else None,
+                       bound if math.isfinite(bound) else None])
+    if len(points) > TRACE_POINTS:
+        keep = np.unique(np.linspace(0, len(points) - 1, TRACE_POINTS).round().astype(int))
+        points = [points[i] for i in keep.tolist()]
+    return points
 
 
 def _run_child(problem, profile, extra, body) -> Schedule:
@@ -334,6 +398,7 @@ def _run_child(problem, profile, extra, body) -> Schedule:
     incumbents: list[tuple[np.ndarray, np.ndarray, str]] = []
     bound: tuple[float, str] | None = None
     answer: tuple | None = None
+    events: list = []
     try:
         _ensure_server()
         with _main_not_reimported():
@@ -350,6 +415,8 @@ def _run_child(problem, profile, extra, body) -> Schedule:
                 message = receive.recv()
             except (EOFError, OSError):  # the child ended without its answer
                 break
+            if message[0] in ("incumbent", "bound"):
+                events.append((time.monotonic(), message))
             if message[0] == "incumbent":
                 incumbents.append(message[1:])
             elif message[0] == "bound":
@@ -369,13 +436,16 @@ def _run_child(problem, profile, extra, body) -> Schedule:
         if answer[0] == "error":
             raise answer[1]
         schedule = answer[1]
-        return dataclasses.replace(schedule, solve_seconds=seconds, extras={**schedule.extras, "watchdog": "child process"})
+        return dataclasses.replace(schedule, solve_seconds=seconds, extras={**schedule.extras, "watchdog": "child process",
+                                                                          "trace": trace_of(problem, events, t0)})
     if time.monotonic() < end and child.exitcode not in (None, 0):  # died early: not a time limit
         how = f"signal {-child.exitcode}" if child.exitcode < 0 else f"exit code {child.exitcode}"
         hint = " (SIGKILL: often the machine's memory ran out)" if child.exitcode == -signal.SIGKILL else ""
         raise UamoptError(f"the solver's process ended without an answer, by {how}{hint}",
                           f"solver {profile.name or profile.solver}", "rerun with isolated = false in the profile to see why")
-    return _after_kill(problem, profile, incumbents, bound, seconds)
+    schedule = _after_kill(problem, profile, incumbents, bound, seconds)
+    schedule.extras["trace"] = trace_of(problem, events, t0)
+    return schedule
 
 
 def _after_kill(problem, profile, incumbents, bound, seconds) -> Schedule:
