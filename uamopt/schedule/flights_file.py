@@ -8,13 +8,15 @@ boundary; the model trusts a FlightSet afterwards.
      "service_start_s": 0, "service_end_s": 3600, "outbound_gap_s": 240, "return_gap_s": 360,
      "flights": [{"id", "aircraft", "route", "origin", "destination", "speed_mps",
                   "planned_departure_s", "max_delay_s", "waypoints": [[x, y, z], ...],
-                  "vertical_rate_mps" (optional)}]}
+                  "vertical_rate_mps" (optional), "turnaround_after_s" (optional)}]}
 
 The four service/gap keys are optional (defaults: 0, 3600 s, the scenario's T_D and T_R) and
 ``max_delay_s`` may be omitted (Eq. 29 with equality). A flight with ``waypoints`` is
 self-contained; one without must name a route of the given ``network``. ``vertical_rate_mps``
 (the vertiport variant): the first segment is a vertical take-off and the last a vertical landing,
-both flown at that rate; the rest at ``speed_mps``.
+both flown at that rate; the rest at ``speed_mps``. ``turnaround_after_s`` (optional): the
+aircraft's turnaround ΔT after this flight, where it is not the leg-parity default (T_D after an
+odd leg of its aircraft, T_R after an even one); the writer puts it where a flight has its own.
 """
 
 from __future__ import annotations
@@ -76,6 +78,11 @@ def flight_from_dict(raw: Any, where: str, network: Mapping[str, np.ndarray] | N
                              f"give 'waypoints' or one of the routes: {known}")
     if track_length_m(wp) <= 0:
         raise InputFileError("the track has zero length", where, "give an origin and a destination that differ")
+    turnaround = raw.get("turnaround_after_s")
+    if turnaround is not None:
+        turnaround = check_number(turnaround, "'turnaround_after_s'", where,
+                                  "give the aircraft's turnaround after this flight in seconds (≥ 0), or omit the key "
+                                  "for the file's outbound_gap_s / return_gap_s", DURATION_S)
     rate = raw.get("vertical_rate_mps")
     if rate is not None:
         rate = check_number(rate, "'vertical_rate_mps'", where,
@@ -89,6 +96,7 @@ def flight_from_dict(raw: Any, where: str, network: Mapping[str, np.ndarray] | N
         id=str(raw["id"]), aircraft=str(raw["aircraft"]), route=str(raw["route"]), origin=str(raw["origin"]),
         destination=str(raw["destination"]), speed_mps=speed, planned_departure_s=departure,
         max_delay_s=float("nan") if max_delay is None else max_delay, waypoints=wp, vertical_rate_mps=rate,
+        turnaround_after_s=turnaround,
     )
 
 
@@ -220,7 +228,11 @@ def load_flights(
 
 
 def flightset_to_dict(flightset: FlightSet) -> dict:
-    """The JSON-ready content of flights.json; every flight self-contained (with waypoints)."""
+    """The JSON-ready content of flights.json; every flight self-contained (with waypoints). A
+    flight's ``turnaround_after_s`` is written where it differs from the file's leg-parity default
+    (``outbound_gap_s`` after an odd leg of its aircraft, ``return_gap_s`` after an even one)."""
+    default = np.where(flightset.leg % 2 == 1, flightset.outbound_gap_s, flightset.return_gap_s)
+    own = flightset.turnaround_after_s != default
     return {
         "cell": list(flightset.cell),
         "conflict_radius": flightset.conflict_radius,
@@ -235,8 +247,9 @@ def flightset_to_dict(flightset: FlightSet) -> dict:
                 "planned_departure_s": f.planned_departure_s, "max_delay_s": f.max_delay_s,
                 "waypoints": f.waypoints.tolist(),
                 **({} if f.vertical_rate_mps is None else {"vertical_rate_mps": f.vertical_rate_mps}),
+                **({"turnaround_after_s": f.turnaround_after_s} if mine else {}),
             }
-            for f in flightset.flights
+            for f, mine in zip(flightset.flights, own.tolist(), strict=True)
         ],
     }
 

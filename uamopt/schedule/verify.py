@@ -20,7 +20,8 @@ the float round-off of that magnitude, ``close_s``):
   arrival ≤ service end (Eq. 26); turnaround gaps are never negative;
 - a return (even leg of its aircraft) is not operated without its outbound;
 - an operated flight departs ≥ the previous operated flight's arrival + ΔT (Eqs. 27-28:
-  T_D after an odd leg, T_R after an even leg);
+  the previous flight's own ``turnaround_after_s`` where flights.json gives one, else T_D after an
+  odd leg, T_R after an even leg);
 - no two operated flights of different aircraft occupy cells within ``conflict_radius`` in every
   axis during overlapping times of more than ``TOL_S`` (touching is not a conflict); the vertical
   phases count like any other segment, timed at the vertical rate;
@@ -228,6 +229,13 @@ def _read_flights(path: Path) -> dict:
             raise InputFileError(f"flight id {shown(rec['id'])} appears twice", where, "give every flight its own id")
         seen.add(rec["id"])
         rec["length"] = sum(math.dist(a, b) for a, b in itertools.pairwise(wps))
+        rec["gap"] = None  # its own turnaround after it; None: the leg-parity default (outbound_gap_s / return_gap_s)
+        if f.get("turnaround_after_s") is not None:
+            rec["gap"] = _number(f["turnaround_after_s"], "turnaround_after_s", where)
+            if not 0 <= rec["gap"] <= MAX_TIME_S:
+                raise InputFileError(f"turnaround_after_s {rec['gap']:g} s outside [0, {MAX_TIME_S:g}] s (a negative "
+                                     "turnaround puts one aircraft in two places at once)", where,
+                                     "rewrite the file with uamopt schedule")
         rec["origin"] = None if f.get("origin") is None else str(f["origin"])
         rec["destination"] = None if f.get("destination") is None else str(f["destination"])
         _phases(rec, f.get("vertical_rate_mps"), where)
@@ -468,14 +476,15 @@ def verify_files(flights_path: Path, schedule_path: Path, summary_path: Path | N
         chain = sorted(chain, key=lambda f: f["planned"])  # stable: file order on ties
         last = None
         for leg, f in enumerate(chain, start=1):
-            f["gap_after_s"] = t_out if leg % 2 == 1 else t_back  # its turnaround ΔT (Eqs. 27-28; pads)
+            # its turnaround ΔT (Eqs. 27-28; pads): its own where the file gives one, else by leg parity
+            f["gap_after_s"] = f["gap"] if f["gap"] is not None else (t_out if leg % 2 == 1 else t_back)
             if leg % 2 == 0 and f["operated"] and not chain[leg - 2]["operated"]:
                 out.append(f"flight {f['id']}: return operated without its outbound {chain[leg - 2]['id']}")
             if not f["operated"]:
                 continue
             if last is not None:
-                prev, prev_leg = last
-                gap = t_out if prev_leg % 2 == 1 else t_back
+                prev, _ = last
+                gap = prev["gap_after_s"]
                 if f["departure"] < prev["arrival"] + gap - TOL_S:
                     out.append(f"flight {f['id']}: departs at {f['departure']:.3f} s, less than {gap:g} s after "
                                f"{prev['id']} arrives at {prev['arrival']:.3f} s (Eqs. 27-28)")
