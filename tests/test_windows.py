@@ -158,10 +158,10 @@ def test_bench_scheduler_flag_runs_the_windows_profile_on_a_started_cluster(tmp_
         rows = list(csv.DictReader(f))
     assert len(rows) == 1 and rows[0]["verified"] == "True" and rows[0]["solver"] == "windows", rows
     gone = run("--solver", str(profile), "--scheduler", "tcp://127.0.0.1:9", "--out", str(tmp_path / "gone"))
-    with open(tmp_path / "gone" / "bench.csv", encoding="utf-8") as f:  # the flag was used: nobody listens there
-        (row,) = list(csv.DictReader(f))
-    # exit code 1: a run that is not a verified schedule (an error row), not bad input
-    assert gone.returncode == 1 and row["status"] == "error" and "cannot reach the Dask scheduler" in row["error"], row
+    # nobody listens there: bad input, found before any instance is built (as `schedule` and `sweep`)
+    lines = gone.stderr.strip().splitlines()
+    assert gone.returncode == 2 and len(lines) == 1 and "cannot reach the Dask scheduler" in lines[0], gone.stderr
+    assert not (tmp_path / "gone").exists()
     refused = run("--solver", "greedy", "--scheduler", cluster, "--out", str(tmp_path / "nothing"))
     lines = refused.stderr.strip().splitlines()
     assert refused.returncode == 2 and len(lines) == 1 and "--scheduler is for the windows solver" in lines[0]

@@ -303,14 +303,15 @@ def cmd_bench(args) -> int:
         _checked_seeds(seeds)  # 32-bit solver seeds, before any instance is built
     profiles = _profiles(args.solver, args.time_limit)
     if getattr(args, "scheduler", None) is not None:  # the windows profiles' tasks on a running Dask cluster
-        from uamopt.cluster import scheduler_address
+        from uamopt.cluster import reach_scheduler
 
         if not any(p.solver == "windows" for p in profiles):
             raise UamoptError(f"--scheduler is for the windows solver, not {', '.join(p.solver for p in profiles)}",
                               "--scheduler", "add a windows profile (--solver windows), or drop --scheduler")
-        # a malformed address is bad input (one line, nothing written); a well-formed one nobody answers
-        # at is each windows run's error row (the cluster can go away between runs too)
-        scheduler_address(args.scheduler)
+        # a malformed address, or one where no scheduler answers now, is bad input (one line, exit 2,
+        # nothing written: as `schedule` and `sweep`); a cluster that goes away between runs is that
+        # run's error row
+        reach_scheduler(args.scheduler)
         profiles = [dataclasses.replace(p, options={**p.options, "scheduler": args.scheduler})
                     if p.solver == "windows" else p for p in profiles]
     airland = [path for path in args.scenario if is_airland(path)]  # OR-Library landing files: instances as they are
