@@ -9,6 +9,7 @@ below the optimum; every bound of a trace can never lie above it.
 from __future__ import annotations
 
 import json
+import time
 from pathlib import Path
 
 import numpy as np
@@ -116,3 +117,23 @@ def test_bench_draws_the_curves_and_lists_every_run(tmp_path, airland8):
     assert [r.split(" | ")[1] for r in rows] == ["highs", "greedy"]
     csv = pd.read_csv(tmp_path / "b" / "bench.csv")
     assert json.loads(csv["trace"][0]) == json.loads(table["trace"][0])
+
+
+def test_the_progress_line_names_incumbent_bound_and_gap_while_an_exact_solve_runs(airland8):
+    """`uamopt schedule` off a terminal: its lines during the solve carry what the watchdog hears."""
+    import io
+
+    from uamopt.progress import Steps
+    from uamopt.solvers import load_profile
+    from uamopt.workflows import solve_progress
+
+    stream = io.StringIO()
+    profile = load_profile("highs")
+    with Steps(1, "schedule", after_s=0.0, interval_s=0.05, stream=stream) as bar, solve_progress(bar, profile):
+        schedule = ua.solve(airland8, profile, time_limit_s=120, threads=1)
+        time.sleep(0.3)  # the ticker writes the last improvement's line
+    assert schedule.status == "optimal"
+    during = [line for line in stream.getvalue().splitlines() if "solving (highs): " in line]
+    assert any("incumbent" in line for line in during)
+    last = during[-1]
+    assert f"incumbent {AIRLAND8_OPTIMUM:.6g}" in last and "bound" in last and "gap" in last, last

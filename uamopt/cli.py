@@ -8,6 +8,7 @@ stderr and exit code 2; results are staged and moved into ``--out`` only when co
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 import time
 import warnings
@@ -112,7 +113,9 @@ def cmd_schedule(args) -> int:
 
     if speed_choice_of(problem) is not None:  # one row per flight, as schedule.csv (not one per speed copy)
         problem, s = collapse(problem, s)
-    print(f"{s.solver}: {s.status}, {problem.objective_kind} objective {s.objective}, operated {s.operated_count}, "
+    bound = (f", bound {s.bound:.6g} (gap {100.0 * s.gap:.2f} %)" if s.bound is not None and s.gap is not None
+             and math.isfinite(s.gap) else "")
+    print(f"{s.solver}: {s.status}, {problem.objective_kind} objective {s.objective}{bound}, operated {s.operated_count}, "
           f"cancelled {s.cancelled_count}, "
           f"total delay {s.total_delay_s:.1f} s, {s.solve_seconds:.2f} s -> {Path(args.out) / 'schedule.csv'}")
     if problems:  # a solver bug, never bad input: say so loudly

@@ -7,6 +7,7 @@ command writes. ``figures=False`` skips the PNGs (``--no-figures``).
 
 from __future__ import annotations
 
+from contextlib import contextmanager
 from pathlib import Path
 
 from uamopt.scenario import Scenario
@@ -137,12 +138,38 @@ def schedule_folder(scenario: Scenario, out: str | Path, profile, flights_file=N
         bar.update(1)
         problem = build_problem(flights, scenario)
         bar.update(1)
-        schedule = solve(problem, profile)
+        bar.set_description(f"solving ({profile.name or profile.solver})")
+        with solve_progress(bar, profile):
+            schedule = solve(problem, profile)
+        bar.set_description("verifying and writing")
         bar.update(1)
         extent = {"extent_m": list(scenario_grid(scenario).extent)}  # the airspace the verifier holds tracks to
         violations = write_schedule(out, problem, schedule, extra=schedule_provenance(scenario, list(overrides or [])) | extent,
                                     check=lambda stage: _verified(stage, out, verify_dir))
         return problem, schedule, violations
+
+
+def solve_line(seconds: float, objective: float | None, bound: float | None) -> str:
+    """``incumbent X, bound Y, gap G %`` (the parts known so far) at ``seconds`` of a solve."""
+    parts = [f"{seconds:.0f} s"]
+    if objective is not None:
+        parts.append(f"incumbent {objective:.6g}")
+    if bound is not None:
+        parts.append(f"bound {bound:.6g}")
+    if objective is not None and bound is not None and abs(objective) > 1e-9:
+        parts.append(f"gap {100.0 * abs(objective - bound) / abs(objective):.2f} %")
+    return ", ".join(parts)
+
+
+@contextmanager
+def solve_progress(bar, profile):
+    """While an exact solve runs, the progress line names its best schedule, bound and gap so far
+    (each improvement the watchdog hears; a line at least every 10 s when piped)."""
+    from uamopt.solvers.watchdog import listening
+
+    name = profile.name or profile.solver
+    with listening(lambda t, o, b: bar.set_description(f"solving ({name}): {solve_line(t, o, b)}")):
+        yield
 
 
 def _verified(stage: Path, out: str | Path, verify_dir) -> list[str]:

@@ -353,35 +353,77 @@ def run(problem: SchedulingProblem, profile: SolverProfile, extra, body) -> Sche
 TRACE_POINTS = 400
 
 
+class Trace:
+    """A solve's progress, built from its reports as they come (:func:`trace_of`); each improvement
+    is also passed to the :func:`listening` callbacks."""
+
+    def __init__(self, problem: SchedulingProblem, t0: float) -> None:
+        self.problem, self.t0 = problem, t0
+        self.best, self.bound = math.inf, -math.inf
+        self.points: list[list] = []
+
+    def add(self, at: float, message: tuple) -> bool:
+        """Take one report made at ``at`` (``time.monotonic()``); True when it improved the best
+        schedule (one the model's own ``violations`` accept) or the best bound."""
+        from uamopt.schedule.model import evaluate, violations
+
+        if message[0] == "incumbent":
+            operated, delay = message[1], message[2]
+            if len(operated) != self.problem.n_flights:
+                return False
+            value = float(evaluate(self.problem, operated, delay))
+            if value >= self.best - 1e-9 * (1.0 + abs(value)) or violations(self.problem, operated, delay):
+                return False
+            self.best = value
+        elif message[0] == "bound":
+            if not message[1] > self.bound:
+                return False
+            self.bound = float(message[1])
+        else:
+            return False
+        point = [round(max(0.0, at - self.t0), 3), self.best if math.isfinite(self.best) else None,
+                 self.bound if math.isfinite(self.bound) else None]
+        self.points.append(point)
+        for listener in list(_LISTENERS):
+            try:
+                listener(*point)
+            except Exception:  # noqa: BLE001 - a progress display must never end the solve
+                pass
+        return True
+
+    def thinned(self) -> list[list]:
+        """The points, at most :data:`TRACE_POINTS` (evenly thinned beyond)."""
+        points = self.points
+        if len(points) > TRACE_POINTS:
+            keep = np.unique(np.linspace(0, len(points) - 1, TRACE_POINTS).round().astype(int))
+            points = [points[i] for i in keep.tolist()]
+        return points
+
+
+_LISTENERS: list = []  # callbacks(seconds, best objective or None, best bound or None) of watched solves
+
+
+@contextmanager
+def listening(callback) -> Iterator[None]:
+    """While the block runs, ``callback(seconds, objective, bound)`` hears every improvement of a
+    watched solve's best schedule or bound, as the parent receives it (``uamopt schedule``'s
+    progress line; objective or bound None until the first)."""
+    _LISTENERS.append(callback)
+    try:
+        yield
+    finally:
+        _LISTENERS.remove(callback)
+
+
 def trace_of(problem: SchedulingProblem, events: list, t0: float) -> list[list]:
     """The solve's progress from its reports: ``[seconds, best objective, best bound]`` each time
     one of them improved (None until the first). An incumbent counts only if the model's own
     ``violations`` accept it; a bound as reported (every reported bound is valid for continuous
     delays). :func:`uamopt.solvers.solve` appends the final answer's point."""
-    from uamopt.schedule.model import evaluate, violations
-
-    best, bound, points = math.inf, -math.inf, []
+    trace = Trace(problem, t0)
     for at, message in events:
-        if message[0] == "incumbent":
-            operated, delay = message[1], message[2]
-            if len(operated) != problem.n_flights:
-                continue
-            value = float(evaluate(problem, operated, delay))
-            if value >= best - 1e-9 * (1.0 + abs(value)) or violations(problem, operated, delay):
-                continue
-            best = value
-        elif message[0] == "bound":
-            if not message[1] > bound:
-                continue
-            bound = float(message[1])
-        else:
-            continue
-        points.append([round(max(0.0, at - t0), 3), best if math.isfinite(best) else None,
-                       bound if math.isfinite(bound) else None])
-    if len(points) > TRACE_POINTS:
-        keep = np.unique(np.linspace(0, len(points) - 1, TRACE_POINTS).round().astype(int))
-        points = [points[i] for i in keep.tolist()]
-    return points
+        trace.add(at, message)
+    return trace.thinned()
 
 
 def _run_child(problem, profile, extra, body) -> Schedule:
@@ -398,7 +440,7 @@ def _run_child(problem, profile, extra, body) -> Schedule:
     incumbents: list[tuple[np.ndarray, np.ndarray, str]] = []
     bound: tuple[float, str] | None = None
     answer: tuple | None = None
-    events: list = []
+    trace = Trace(problem, t0)
     try:
         _ensure_server()
         with _main_not_reimported():
@@ -416,7 +458,7 @@ def _run_child(problem, profile, extra, body) -> Schedule:
             except (EOFError, OSError):  # the child ended without its answer
                 break
             if message[0] in ("incumbent", "bound"):
-                events.append((time.monotonic(), message))
+                trace.add(time.monotonic(), message)
             if message[0] == "incumbent":
                 incumbents.append(message[1:])
             elif message[0] == "bound":
@@ -437,14 +479,14 @@ def _run_child(problem, profile, extra, body) -> Schedule:
             raise answer[1]
         schedule = answer[1]
         return dataclasses.replace(schedule, solve_seconds=seconds, extras={**schedule.extras, "watchdog": "child process",
-                                                                          "trace": trace_of(problem, events, t0)})
+                                                                          "trace": trace.thinned()})
     if time.monotonic() < end and child.exitcode not in (None, 0):  # died early: not a time limit
         how = f"signal {-child.exitcode}" if child.exitcode < 0 else f"exit code {child.exitcode}"
         hint = " (SIGKILL: often the machine's memory ran out)" if child.exitcode == -signal.SIGKILL else ""
         raise UamoptError(f"the solver's process ended without an answer, by {how}{hint}",
                           f"solver {profile.name or profile.solver}", "rerun with isolated = false in the profile to see why")
     schedule = _after_kill(problem, profile, incumbents, bound, seconds)
-    schedule.extras["trace"] = trace_of(problem, events, t0)
+    schedule.extras["trace"] = trace.thinned()
     return schedule
 
 
