@@ -362,8 +362,9 @@ def interrupt_trials(tmp_path: Path, trials: int, seed: int, commands: list[str]
 
 
 def test_interrupts_at_random_moments(tmp_path):
-    outcomes = interrupt_trials(tmp_path, trials=2, seed=10, commands=["risk"])
-    assert sum(outcomes.values()) == 2
+    """Two interrupted `risk` runs; check_outcome holds each to the invariants (no traceback, no
+    staging folder or temporary file left, the folder absent or complete, the right last line)."""
+    interrupt_trials(tmp_path, trials=2, seed=10, commands=["risk"])
 
 
 @pytest.mark.slow

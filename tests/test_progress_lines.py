@@ -44,11 +44,20 @@ def test_an_interrupted_run_says_stopped():
     assert stream.getvalue().splitlines()[-1].endswith(" - stopped")
 
 
-def test_the_commands_use_it():
-    from uamopt.workflows import progress
+def test_a_long_command_prints_its_lines_when_piped(tmp_path):
+    """`uamopt schedule` with a 15 s exact solve (longer than the 10 s between lines), its stderr a
+    pipe: plain step lines, the solve's own among them, and no bar."""
+    import subprocess
+    import sys
 
-    bar = progress(2, "risk")
-    try:
-        assert isinstance(bar, Steps)
-    finally:
-        bar.close()
+    profile = tmp_path / "h.toml"
+    profile.write_text('solver = "highs"\ntime_limit_s = 15.0\nthreads = 1\n', encoding="utf-8")
+    done = subprocess.run([sys.executable, "-m", "uamopt", "schedule", "paper_case", "--solver", str(profile),
+                           "--set", 'schedule.objective="weighted"', "--set", "schedule.flights=600",
+                           "--set", "schedule.aircraft=100", "--out", str(tmp_path / "out")],
+                          capture_output=True, text=True, timeout=600, cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    lines = done.stderr.splitlines()
+    assert lines and all(line.startswith("schedule: ") for line in lines), done.stderr
+    assert any(" - solving (h): " in line and "incumbent" in line for line in lines), done.stderr
+    assert lines[-1].endswith(" - done") and "\r" not in done.stderr
