@@ -155,6 +155,8 @@ def test_ctrl_c_ends_the_child_and_the_command(tmp_path):
     pid_file = tmp_path / "child.pid"
     script = tmp_path / "run.py"
     script.write_text(textwrap.dedent(f"""
+        import faulthandler, signal
+        faulthandler.register(signal.SIGUSR1)
         from instances import crossing_problem
         from watchdog_bodies import pid_body
         from uamopt.solvers import SolverProfile, watchdog
@@ -173,7 +175,14 @@ def test_ctrl_c_ends_the_child_and_the_command(tmp_path):
         time.sleep(0.1)
     child = int(pid_file.read_text())
     os.kill(proc.pid, signal.SIGINT)
-    out, err = proc.communicate(timeout=60)
+    try:
+        out, err = proc.communicate(timeout=60)
+    except subprocess.TimeoutExpired:  # say what the parent was doing (its stack, via faulthandler) before failing
+        os.kill(proc.pid, signal.SIGUSR1)
+        time.sleep(1.0)
+        proc.kill()
+        out, err = proc.communicate()
+        pytest.fail(f"the parent did not end within 60 s of SIGINT; stdout {out!r}, stderr {err[-4000:]}")
     assert out.strip() == "interrupted", err
     assert not _alive(child)
 
