@@ -360,6 +360,9 @@ class Trace:
     def __init__(self, problem: SchedulingProblem, t0: float) -> None:
         self.problem, self.t0 = problem, t0
         self.best, self.bound = math.inf, -math.inf
+        self.schedule: tuple[np.ndarray, np.ndarray, str] | None = None  # the best accepted (operated, delay, source)
+        self.bound_source = ""
+        self.reported = 0  # schedules reported
         self.points: list[list] = []
 
     def add(self, at: float, message: tuple) -> bool:
@@ -368,17 +371,18 @@ class Trace:
         from uamopt.schedule.model import evaluate, violations
 
         if message[0] == "incumbent":
+            self.reported += 1
             operated, delay = message[1], message[2]
             if len(operated) != self.problem.n_flights:
                 return False
             value = float(evaluate(self.problem, operated, delay))
             if value >= self.best - 1e-9 * (1.0 + abs(value)) or violations(self.problem, operated, delay):
                 return False
-            self.best = value
+            self.best, self.schedule = value, (operated, delay, str(message[3]))
         elif message[0] == "bound":
             if not message[1] > self.bound:
                 return False
-            self.bound = float(message[1])
+            self.bound, self.bound_source = float(message[1]), str(message[2])
         else:
             return False
         point = [round(max(0.0, at - self.t0), 3), self.best if math.isfinite(self.best) else None,
@@ -437,8 +441,6 @@ def _run_child(problem, profile, extra, body) -> Schedule:
     keep, lifeline = ctx.Pipe(duplex=False)  # the child's lifeline: its recv ends when `keep` closes
     child = ctx.Process(target=_child, args=(channel, keep, problem, profile, extra, body, deadline),
                         name=f"uamopt-{profile.solver}", daemon=True)
-    incumbents: list[tuple[np.ndarray, np.ndarray, str]] = []
-    bound: tuple[float, str] | None = None
     answer: tuple | None = None
     trace = Trace(problem, t0)
     try:
@@ -459,11 +461,6 @@ def _run_child(problem, profile, extra, body) -> Schedule:
                 break
             if message[0] in ("incumbent", "bound"):
                 trace.add(time.monotonic(), message)
-            if message[0] == "incumbent":
-                incumbents.append(message[1:])
-            elif message[0] == "bound":
-                if bound is None or message[1] > bound[0]:
-                    bound = (message[1], message[2])
             else:
                 answer = message
     finally:
@@ -485,26 +482,20 @@ def _run_child(problem, profile, extra, body) -> Schedule:
         hint = " (SIGKILL: often the machine's memory ran out)" if child.exitcode == -signal.SIGKILL else ""
         raise UamoptError(f"the solver's process ended without an answer, by {how}{hint}",
                           f"solver {profile.name or profile.solver}", "rerun with isolated = false in the profile to see why")
-    schedule = _after_kill(problem, profile, incumbents, bound, seconds)
+    schedule = _after_kill(problem, profile, trace, seconds)
     schedule.extras["trace"] = trace.thinned()
     return schedule
 
 
-def _after_kill(problem, profile, incumbents, bound, seconds) -> Schedule:
+def _after_kill(problem, profile, trace: Trace, seconds) -> Schedule:
     """The answer of a child ended at its deadline: its best reported schedule that the model
-    accepts (else every flight cancelled, where that is allowed), the best reported bound (else
-    :func:`separable_bound`), status ``time_limit``."""
+    accepts (the trace keeps it; else every flight cancelled, where that is allowed), the best
+    reported bound (else :func:`separable_bound`), status ``time_limit``."""
     from uamopt.schedule.model import evaluate, make_schedule, violations
     from uamopt.solvers.warmstart import no_schedule
 
     n = problem.n_flights
-    best = None
-    for operated, delay, source in incumbents:
-        if len(operated) != n or violations(problem, operated, delay):
-            continue
-        value = evaluate(problem, operated, delay)
-        if best is None or value < best[0]:
-            best = (value, operated, delay, source)
+    best = None if trace.schedule is None else (trace.best, *trace.schedule)
     name = profile.name or profile.solver
     if best is None:
         none = np.zeros(n, dtype=bool)
@@ -513,11 +504,11 @@ def _after_kill(problem, profile, incumbents, bound, seconds) -> Schedule:
                               f"time limit ({seconds:.1f} s)")
         best = (evaluate(problem, none, np.zeros(n)), none, np.zeros(n), "none reported: every flight cancelled")
     value, source = separable_bound(problem), "the separable bound (every flight at its own best choice)"
-    if bound is not None and bound[0] > value:
-        value, source = bound
+    if trace.bound > value:
+        value, source = trace.bound, trace.bound_source
     extras = {"termination": "ended at the time limit by the watchdog",
               "watchdog": f"the child process did not answer by {kill_at(profile.time_limit_s):.1f} s "
-                          f"(limit {profile.time_limit_s:g} s) and was ended; {len(incumbents)} schedule(s) reported",
+                          f"(limit {profile.time_limit_s:g} s) and was ended; {trace.reported} schedule(s) reported",
               "incumbent": best[3], "bound_source": source}
     return make_schedule(problem, profile.solver, "time_limit", best[1], best[2], bound=float(min(value, best[0])),
                          solve_seconds=seconds, seed=profile.seed, extras=extras)
