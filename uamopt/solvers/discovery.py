@@ -63,7 +63,10 @@ Savelsbergh ("The continuous-time service network design problem", Operations Re
 2017); the cells here are delays, and the cuts are the forbidden intervals' ends.
 
 Applies to problems without the ``cumulative`` shape (pads) and with a delay cost non-decreasing
-in the delay (not earliness/tardiness): :data:`SHAPES`, :data:`OBJECTIVES`.
+in the delay: :data:`SHAPES`, :data:`OBJECTIVES`. A one-runway problem (every pair of flights
+separated, every flight operated, whole-second data: the aircraft-landing problem) goes to
+:mod:`uamopt.solvers.runway` instead, for every objective kind, earliness/tardiness included; an
+earliness/tardiness problem of any other shape is refused in one line.
 """
 
 from __future__ import annotations
@@ -76,6 +79,7 @@ from typing import Literal
 
 import numpy as np
 
+from uamopt.errors import UamoptError
 from uamopt.schedule.flights import TIME_TOL_S
 from uamopt.schedule.model import Schedule, SchedulingProblem, evaluate, make_schedule, violations
 from uamopt.solvers.warmstart import no_worse
@@ -476,7 +480,8 @@ def discover(problem: SchedulingProblem, small: SchedulingProblem, deadline: flo
 
 # --- the solver --------------------------------------------------------------------------------------
 SHAPES = frozenset({"bounds", "must_operate", "precedence", "turnaround", "pairs"})
-OBJECTIVES = frozenset({"weighted", "lexicographic"})
+#: earliness/tardiness only on one-runway problems (runway.py); solve() refuses it elsewhere in one line
+OBJECTIVES = frozenset({"weighted", "lexicographic", "earliness_tardiness"})
 LNS_MIN_S = 2.0  # no neighbourhood search with less time than this left, s
 
 
@@ -484,9 +489,15 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
     """Discovery rounds for the bound and incumbents, then neighbourhood search on the best schedule
     (lns.py) for the last ``lns_share`` of the limit. Status ``optimal`` when the bound meets the
     schedule (proved for continuous delays), else ``time_limit``; ``bound`` is the best round's."""
-    from uamopt.solvers import lns
+    from uamopt.solvers import lns, runway
     from uamopt.solvers.warmstart import no_schedule, reduced, warm_start
 
+    one_runway = runway.of(problem)
+    if not isinstance(one_runway, str):
+        return runway.solve(problem, profile, one_runway)
+    if problem.objective.kind == "earliness_tardiness":
+        raise UamoptError(f"discovery takes earliness/tardiness only on one-runway problems, and this one has {one_runway}",
+                          f"profile {profile.name or 'discovery'}", "use highs or cpsat for this problem")
     o = profile.option
     t0 = time.perf_counter()
     limit = profile.time_limit_s
