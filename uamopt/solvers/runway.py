@@ -563,6 +563,12 @@ def order_of(runway: Runway, flights: np.ndarray, times: np.ndarray) -> np.ndarr
     return np.lexsort((np.arange(n), at))
 
 
+def order_of_through(runway: Runway, value_through: np.ndarray) -> np.ndarray:
+    """A landing order: each flight at the time whose path value through it (:func:`through`) is least."""
+    best = np.array([int(np.argmin(value_through[runway.offset[j]:runway.offset[j + 1]])) for j in range(runway.n)])
+    return np.lexsort((np.arange(runway.n), runway.start + best))
+
+
 def _target_time(runway: Runway) -> np.ndarray:
     """Each flight's cheapest time (its target)."""
     best = np.array([int(np.argmin(runway.cost[runway.offset[j]:runway.offset[j + 1]])) for j in range(runway.n)])
@@ -745,8 +751,9 @@ class Dual:
 
 
 #: subgradient steps: the step factor shrinks by STEP_SHRINK after STALL steps without a better
-#: bound, and the steps end when it falls below STEP_MIN; a path is read as a schedule every READ_EVERY steps
-STALL, STEP_SHRINK, STEP_MIN, READ_EVERY = 40, 1.5, 1e-4, 10
+#: bound, and the steps end when it falls below STEP_MIN; a path is read as a schedule every READ_EVERY
+#: steps (READ_EVERY_TWO on two-cycle-free paths, closer to schedules)
+STALL, STEP_SHRINK, STEP_MIN, READ_EVERY, READ_EVERY_TWO = 40, 1.5, 1e-4, 10, 3
 
 
 def ascend(runway: Runway, objective, deadline: float, on_bound=None, on_schedule=None, *, two_cycle: bool = False,
@@ -768,6 +775,7 @@ def ascend(runway: Runway, objective, deadline: float, on_bound=None, on_schedul
                     value=start.value, delay=start.delay, order=start.order)
     lam = best.lam.copy()
     stall, step = 0, 0
+    every = READ_EVERY_TWO if two_cycle else READ_EVERY
     while factor >= STEP_MIN and time.perf_counter() < deadline:
         bound, flights, times = path_bound(runway, lam, two_cycle)
         step += 1
@@ -779,7 +787,7 @@ def ascend(runway: Runway, objective, deadline: float, on_bound=None, on_schedul
             stall += 1
             if stall >= STALL:
                 factor, stall = factor / STEP_SHRINK, 0
-        if step % READ_EVERY == 1:
+        if (step - 1) % every == 0:
             order = order_of(runway, flights, times)
             got = timed(runway, order, objective)
             if got is not None and got[0] < best.value - 1e-9:
@@ -799,20 +807,25 @@ def ascend(runway: Runway, objective, deadline: float, on_bound=None, on_schedul
 
 
 def neighbourhoods(runway: Runway, lo: np.ndarray, hi: np.ndarray, objective, delay: np.ndarray, value: float,
-                   deadline: float, threads: int, seed: int, size: int, window_s: float, on_schedule=None):
+                   deadline: float, threads: int, seed: int, size: int, window_s: float, on_schedule=None,
+                   narrowed=None):
     """Large neighbourhood search: ``size`` consecutive landings of the schedule are freed (each within
     its window [lo, hi]), every other flight kept at its time, and the part solved exactly
-    (:func:`exact_in_windows`, at most ``window_s`` each); windows advance by half their size;
-    passes repeat while one gains. Returns (value, delay, parts solved, parts improved)."""
-    solved = improved = 0
+    (:func:`exact_in_windows`, at most ``window_s`` each); windows advance by half their size, every
+    other pass shifted by a quarter; passes repeat while one gains. ``narrowed(value)``, if given,
+    gives the windows again for a better schedule (reduced-cost fixing against it). Returns (value,
+    delay, parts solved, parts improved)."""
+    solved = improved = passes = 0
     gained = True
     while gained and time.perf_counter() < deadline:
         gained = False
         order = np.argsort(runway.start + delay, kind="stable")
-        for first in range(0, max(1, runway.n - size // 2), max(1, size // 2)):
+        shift = (size // 4) * (passes % 2)
+        passes += 1
+        for first in range(-shift, max(1, runway.n - size // 2), max(1, size // 2)):
             if time.perf_counter() >= deadline:
                 break
-            free = order[first:first + size]
+            free = order[max(0, first):first + size]
             x = np.round(runway.start + delay).astype(np.int64)
             wlo, whi = x.copy(), x.copy()
             wlo[free], whi[free] = lo[free], hi[free]
@@ -825,7 +838,11 @@ def neighbourhoods(runway: Runway, lo: np.ndarray, hi: np.ndarray, objective, de
                 improved += 1
                 gained = True
                 if on_schedule is not None:
-                    on_schedule(delay, f"runway: neighbourhood {first}-{first + len(free)}")
+                    on_schedule(delay, f"runway: neighbourhood of landings {first}-{first + len(free)}")
+        if gained and narrowed is not None:
+            windows = narrowed(value)
+            if windows is not None:
+                lo, hi = windows
     return value, delay, solved, improved
 
 
@@ -834,7 +851,7 @@ def neighbourhoods(runway: Runway, lo: np.ndarray, hi: np.ndarray, objective, de
 #: SEARCH_END, then the exact model within the fixed windows; neighbourhoods of SEARCH_SIZE landings,
 #: at most SEARCH_WINDOW_S each
 ONE_CYCLE_SHARE, TWO_CYCLE_FACTOR = 0.15, 0.1
-DUAL_SHARE, SEARCH_END, SEARCH_SIZE, SEARCH_WINDOW_S = 0.35, 0.6, 30, 10.0
+DUAL_SHARE, SEARCH_END, SEARCH_SIZE, SEARCH_WINDOW_S = 0.35, 0.75, 12, 3.0
 
 
 def solve(problem: SchedulingProblem, profile, runway: Runway):
@@ -871,6 +888,10 @@ def solve(problem: SchedulingProblem, profile, runway: Runway):
     extras: dict = {"lagrangian_bound": dual.bound, "one_cycle_bound": one_cycle, "subgradient_steps": dual.steps,
                     "separation_classes": int(runway.class_sep.shape[0])}
     through_value = through(runway, dual.lam, two_cycle)
+    got = timed(runway, order_of_through(runway, through_value), objective)
+    if got is not None and got[0] < value - 1e-9:
+        value, delay = got
+        schedule_found(delay, "runway: the order of least path values")
     windows = windows_after_fixing(runway, through_value, value)
     solved = improved = 0
     exact = None
@@ -878,7 +899,8 @@ def solve(problem: SchedulingProblem, profile, runway: Runway):
         lo, hi = windows
         value, delay, solved, improved = neighbourhoods(runway, lo, hi, objective, delay, value,
                                                         t0 + SEARCH_END * limit, profile.threads, profile.seed,
-                                                        SEARCH_SIZE, SEARCH_WINDOW_S, schedule_found)
+                                                        SEARCH_SIZE, SEARCH_WINDOW_S, schedule_found,
+                                                        lambda upper: windows_after_fixing(runway, through_value, upper))
         windows = windows_after_fixing(runway, through_value, value)
     if windows is not None and value - bound > 1e-9 * (1.0 + abs(value)) and time.perf_counter() < t0 + limit:
         lo, hi = windows
