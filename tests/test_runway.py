@@ -107,7 +107,7 @@ def test_the_two_cycle_programme_matches_an_exhaustive_one(tmp_path, seed):
         reduced = r.cost - np.repeat(lam, r.length)
         exact = lam.sum() + r.constant + all_paths_min_two(r, reduced)
         # with room for every label the programme is exact, and its path has no p, q, p
-        value, flights, times = runway.path_bound(r, lam, two_cycle=True, keep=4 * r.n)
+        value, flights, _ = runway.path_bound(r, lam, two_cycle=True, keep=4 * r.n)
         assert value == pytest.approx(exact, abs=1e-9)
         assert all(a != c for a, c in zip(flights, flights[2:], strict=False))
         # with the default room a label may stand in for an excluded one: between the two programmes' values

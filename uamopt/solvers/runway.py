@@ -14,28 +14,34 @@ schedules is a bound for continuous times.
 **The bound.** Flights fall into classes of identical separation rows and columns (airland9–13:
 four). A *path* is a sequence of landings (flight j at whole time t ∈ its window) in which
 consecutive landings of classes a, b are at least sep(a, b) apart and no flight lands twice in a
-row; it may skip flights and repeat others. Every schedule's landing order is such a path (its
-consecutive pairs are separated), so with multipliers λ_j on "flight j lands once",
+row (with ``two_cycle``: nor p, q, p); it may skip flights and repeat others. Every schedule's
+landing order is such a path (its consecutive pairs are separated), so with multipliers λ_j on
+"flight j lands once",
 
     L(λ) = Σ_j λ_j + min over paths Σ_(j,t) ∈ path (c_j(t) − λ_j)
 
 is a lower bound of every schedule for every λ (Lagrangian relaxation of the time-indexed
-formulation with sequence-dependent separation; the arc-time-indexed bound of Pessoa, Uchoa,
+formulation with sequence-dependent separation: the arc-time-indexed bound of Pessoa, Uchoa,
 Poggi de Aragão and Rodrigues, *Exact algorithm over an arc-time-indexed formulation for parallel
-machine scheduling problems*, Math. Prog. Comp. 2, 2010, with classes in place of jobs and
-two-cycle... here one-cycle elimination). The best path is a dynamic programme over time with the
-best two paths (of distinct last flights) per class kept as prefix minima: O(n · W · C) per λ, W
-the window length, C the classes (:func:`_best_path`, compiled by numba). λ follows subgradient
+machine scheduling problems*, Math. Prog. Comp. 2, 2010, with classes in place of jobs, and the
+usual one- and two-cycle elimination). The best path is a dynamic programme over time with, per
+class and time, the best labels so far as prefix minima: O(n · W · C) per λ, W the window length,
+C the classes (:func:`_best_path`, :func:`_best_path2`, compiled by numba). λ follows subgradient
 steps (Polyak's, towards the best schedule's value).
+
+**Fixing.** :func:`through` bounds every schedule that uses a given landing; the landings whose
+bound exceeds the best schedule's value are in no better schedule, and what is left of each window
+(:func:`windows_after_fixing`) bounds the exact model (:func:`exact_in_windows`).
 
 **Schedules.** Each path read as an order (a flight's mean landing time in it; a skipped flight at
 its target), the best times for that order by an LP (HiGHS; every pair of the order separated,
-added where broken), then adjacent swaps while they gain (:func:`timed`, :func:`improve`).
+added where broken: :func:`timed`), then neighbourhoods of consecutive landings solved exactly
+within the windows (:func:`neighbourhoods`).
 
-Measured (airland9, 100 aircraft, 4 classes, load 0.9): the bound without the no-repeat rule
-converges to 5,127.47 (the LP of the class-flow formulation, solved by HiGHS in 211 s to the same
-value); with it 5,528 after 200 steps; the literature's optimum is 5,611.70; HiGHS on the big-M
-model reaches 3,421 in 300 s.
+Measured on airland9 (100 aircraft, 4 classes; optimum 5,611.70): HiGHS on the big-M model reaches
+a bound of 3,421 in 300 s; paths with repeats converge to 5,127.47 (the LP of the class-flow
+formulation, solved by HiGHS in 211 s to the same value); without p, p to 5,552.2; without p, q, p
+the path becomes a schedule of 5,611.70 within 5 s (docs/exact_scheduling.md, *One runway*).
 """
 
 from __future__ import annotations
@@ -130,7 +136,7 @@ def of(problem: SchedulingProblem) -> Runway | str:
     sep = np.zeros((n, n), dtype=np.int64)
     sep[pairs.p, pairs.q] = np.round(hi).astype(np.int64)
     sep[pairs.q, pairs.p] = np.round(-lo).astype(np.int64)
-    base = int(round(float(np.min(d0))))
+    base = round(float(np.min(d0)))
     start = np.round(d0).astype(np.int64) - base
     length = np.round(upper).astype(np.int64) + 1
     offset = np.zeros(n + 1, dtype=np.int64)
@@ -162,7 +168,7 @@ def _classes(sep: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
             if j == i:
                 continue
             others[:] = True
-            others[[i, j]] = False
+            others[np.array([i, j])] = False
             same[idx] = (sep[i, j] == sep[j, i] and np.array_equal(key[i, others], key[j, others])
                          and np.array_equal(key[others, i], key[others, j]))
         cls[free[same]] = count
@@ -633,25 +639,6 @@ def _terms(runway: Runway, objective):
     return runway.start.astype(float), np.zeros(n), np.zeros(n), float(objective.per_delay)
 
 
-def improve(runway: Runway, order: np.ndarray, value: float, delay: np.ndarray, objective, deadline: float):
-    """Adjacent swaps of the order, each kept when the timed order is cheaper, until none gains or
-    the deadline passes: (order, value, delay)."""
-    order = order.copy()
-    gained = True
-    while gained and time.perf_counter() < deadline:
-        gained = False
-        for k in range(runway.n - 1):
-            if time.perf_counter() >= deadline:
-                break
-            trial = order.copy()
-            trial[k], trial[k + 1] = trial[k + 1], trial[k]
-            got = timed(runway, trial, objective)
-            if got is not None and got[0] < value - 1e-9:
-                order, (value, delay) = trial, got
-                gained = True
-    return order, value, delay
-
-
 def windows_after_fixing(runway: Runway, value_through: np.ndarray, upper: float) -> tuple[np.ndarray, np.ndarray] | None:
     """Each flight's least and greatest landing time (relative) among the landings whose path
     value does not exceed ``upper`` (:func:`through`): every schedule of objective ≤ ``upper``
@@ -705,7 +692,7 @@ def exact_in_windows(runway: Runway, lo: np.ndarray, hi: np.ndarray, objective, 
                  np.array([1.0, 1.0, -1.0]))
     binaries = []
     keep = both | need
-    for p, q, a, b in zip(p_idx[keep].tolist(), q_idx[keep].tolist(), pq[keep].tolist(), qp[keep].tolist()):
+    for p, q, a, b in zip(p_idx[keep].tolist(), q_idx[keep].tolist(), pq[keep].tolist(), qp[keep].tolist(), strict=True):
         if a and not b:
             h.addRow(float(sep[p, q]), inf, 2, np.array([q, p], dtype=np.int32), np.array([1.0, -1.0]))
         elif b and not a:
@@ -829,7 +816,7 @@ def neighbourhoods(runway: Runway, lo: np.ndarray, hi: np.ndarray, objective, de
             x = np.round(runway.start + delay).astype(np.int64)
             wlo, whi = x.copy(), x.copy()
             wlo[free], whi[free] = lo[free], hi[free]
-            status, got, new, _ = exact_in_windows(runway, wlo, whi, objective,
+            _, got, new, _ = exact_in_windows(runway, wlo, whi, objective,
                                                    min(deadline, time.perf_counter() + window_s), threads, seed,
                                                    start=delay)
             solved += 1
