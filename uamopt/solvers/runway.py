@@ -741,6 +741,10 @@ class Dual:
 #: bound, and the steps end when it falls below STEP_MIN; a path is read as a schedule every READ_EVERY
 #: steps (READ_EVERY_TWO on two-cycle-free paths, closer to schedules)
 STALL, STEP_SHRINK, STEP_MIN, READ_EVERY, READ_EVERY_TWO = 40, 1.5, 1e-4, 10, 3
+#: the steps stall while the bound rises by less than GAIN (relative) in all since the last gain;
+#: they end once the bound is within CLOSE (relative) of the best schedule (the exact model within
+#: the windows then proves it)
+GAIN, CLOSE = 1e-5, 1e-5
 
 
 def ascend(runway: Runway, objective, deadline: float, on_bound=None, on_schedule=None, *, two_cycle: bool = False,
@@ -762,14 +766,17 @@ def ascend(runway: Runway, objective, deadline: float, on_bound=None, on_schedul
                     value=start.value, delay=start.delay, order=start.order)
     lam = best.lam.copy()
     stall, step = 0, 0
+    ref = best.bound
     every = READ_EVERY_TWO if two_cycle else READ_EVERY
     while factor >= STEP_MIN and time.perf_counter() < deadline:
         bound, flights, times = path_bound(runway, lam, two_cycle)
         step += 1
-        if bound > best.bound + 1e-9 * (1.0 + abs(bound)):
-            best.bound, best.lam, stall = bound, lam.copy(), 0
+        if bound > best.bound:
+            best.bound, best.lam = bound, lam.copy()
             if on_bound is not None:
                 on_bound(bound)
+        if best.bound - ref > GAIN * (1.0 + abs(best.bound)):  # a gain since the last one counted
+            ref, stall = best.bound, 0
         else:
             stall += 1
             if stall >= STALL:
@@ -781,6 +788,8 @@ def ascend(runway: Runway, objective, deadline: float, on_bound=None, on_schedul
                 best.value, best.delay, best.order = got[0], got[1], order
                 if on_schedule is not None:
                     on_schedule(best.delay, f"runway: the path of subgradient step {best.steps + step}")
+        if best.value - best.bound <= CLOSE * (1.0 + abs(best.value)):  # proved, or left to the exact model
+            break
         g = 1.0 - np.bincount(flights, minlength=runway.n)
         norm = float(g @ g)
         if norm == 0.0:  # the path lands every flight once: a schedule whose cost is the bound
