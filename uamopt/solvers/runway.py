@@ -904,11 +904,12 @@ def solve(problem: SchedulingProblem, profile, runway: Runway):
         status, got, new, inner = exact_in_windows(runway, lo, hi, objective, t0 + limit, profile.threads,
                                                    profile.seed, start=delay)
         exact = status
-        if got is not None and new is not None and got < value and not violations(problem, operated, new):
+        sound = got is not None and new is not None and not violations(problem, operated, new)
+        if sound and got < value:
             value, delay = got, new
             schedule_found(delay, "runway: HiGHS within the windows")
         if status == "optimal" and got is not None:
-            inner = got
+            inner = got if sound else None  # a proof of a schedule that breaks a row proves nothing
         if inner is not None:  # every schedule of objective ≤ the incumbent's lands within the windows
             bound = max(bound, min(value, inner))
     value = evaluate(problem, operated, delay)
