@@ -52,7 +52,10 @@ def test_every_solver_says_infeasible(make, kind):
     assert bruteforce.solve(problem).status == "infeasible"  # the oracle: no schedule exists
     for name in EXACT + HEURISTICS:
         schedule = ua.solve(problem, name, time_limit_s=20)
-        assert schedule.status == "infeasible", (name, schedule.status)
+        # an exact solver proves it for continuous delays; a heuristic finds none and proves nothing
+        want = ("infeasible", "continuous") if name in EXACT else ("no_solution", "none")
+        assert (schedule.termination, schedule.proved_for) == want, (name, schedule.termination, schedule.proved_for)
+        assert schedule.status == want[0] and not schedule.found
         assert schedule.objective is None
         if name in EXACT:  # a proof, with the pinned flights named
             assert "A1" in schedule.extras["reason"] and schedule.extras["reason"].startswith("no schedule operates")
@@ -77,7 +80,7 @@ def test_raise_for_status_names_the_reason_and_nothing_is_written(name, tmp_path
 
     problem = crossing("lexicographic")
     schedule = ua.solve(problem, name, time_limit_s=20)
-    assert schedule.status == "infeasible"
+    assert schedule.status == ("infeasible" if name == "highs" else "no_solution")
     with pytest.raises(InfeasibleScheduleError) as raised:
         schedule.raise_for_status()
     line = raised.value.line()

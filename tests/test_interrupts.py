@@ -209,7 +209,7 @@ from bench_exact import ladder_problem
 import uamopt as ua
 from uamopt.solvers import SolverProfile
 schedule = ua.solve(ladder_problem(1000), SolverProfile("highs", time_limit_s=20.0, threads=1))
-print("status", schedule.status, schedule.extras.get("termination"))
+print("status", schedule.status, schedule.extras.get("engine_termination"))
 """
 
 

@@ -206,7 +206,7 @@ def test_gantt_draws_one_bar_per_operated_flight(schedules):
     operated[[2, 5, 9]] = False
     delay_s = np.zeros(problem.n_flights)
     delay_s[[0, 4]] = [30.0, 60.0]
-    schedule = Schedule("by hand", "feasible", operated, delay_s, objective=None)
+    schedule = Schedule("by hand", "stopped", operated, delay_s, objective=None)
     fig, ax = _one_axes((14, 8))
     assert plotting.gantt(problem, schedule, ax) is fig
     shown, cancelled = ax.containers

@@ -162,7 +162,7 @@ def test_problem_and_objective(paper):
     assert evaluate(problem, on, delay) == pytest.approx(0.6 * 401.0 / 20 - 0.4 * 120)  # Eqs. 20-22
     # Table 3's initial plan: 109 operated, total delay 2401 s -> T_d = 120.05 s
     on[:11] = False
-    sched = make_schedule(problem, "test", "feasible", on, np.where(on, 2401.0 / 109, 0.0))
+    sched = make_schedule(problem, "test", "stopped", on, np.where(on, 2401.0 / 109, 0.0))
     assert sched.operated_count == 109 and sched.cancelled_count == 11
     assert sched.avg_delay_s == pytest.approx(120.05) and sched.objective == pytest.approx(0.6 * 120.05 - 0.4 * 109)
     lex = build_problem(fs, scenario, objective="lexicographic")
@@ -202,7 +202,7 @@ def test_write_schedule_files(paper, tmp_path):
     on = np.zeros(n, bool)
     on[problem.chains[0]] = True
     delay = np.zeros(n)
-    sched = make_schedule(problem, "none", "feasible", on, delay, bound=-3.0, solve_seconds=0.5, seed=4)
+    sched = make_schedule(problem, "none", "stopped", on, delay, bound=-3.0, solve_seconds=0.5, seed=4)
     write_schedule(tmp_path / "out", problem, sched)
     names = sorted(p.name for p in (tmp_path / "out").iterdir())
     assert names == ["flights.json", "schedule.csv", "summary.json"]

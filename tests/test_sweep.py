@@ -22,9 +22,9 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 TINY = ROOT / "tests" / "data" / "sweeps" / "tiny.toml"
 PAPER = ROOT / "models" / "paper_case.toml"
-COLUMNS = ["case", "schedule.aircraft", "aircraft.cruise_speed_mps", "solver", "seed", "status", "model", "objective_kind",
-           "objective", "bound", "gap", "operated", "cancelled", "total_delay_s", "avg_delay_s", "verified", "seconds",
-           "risk_cost", "transport_cost", "length_m", "n_waypoints"]
+COLUMNS = ["case", "schedule.aircraft", "aircraft.cruise_speed_mps", "solver", "seed", "status", "termination",
+           "proved_for", "model", "objective_kind", "objective", "bound", "gap", "operated", "cancelled", "total_delay_s",
+           "avg_delay_s", "verified", "seconds", "risk_cost", "transport_cost", "length_m", "n_waypoints"]
 
 
 def uamopt(*args, timeout: float = 300) -> subprocess.CompletedProcess:
@@ -85,6 +85,8 @@ def test_results_table(reference):
     assert table["avg_delay_s"].tolist() == pytest.approx((table["total_delay_s"] / table["aircraft"]).tolist())
     highs, greedy = table[table["solver"] == "highs"], table[table["solver"] == "greedy"]
     assert (highs["status"] == "optimal").all() and (highs["gap"] < 1e-6).all()
+    assert (highs["termination"] == "optimal").all() and (highs["proved_for"] == "continuous").all()
+    assert (greedy["termination"] == "stopped").all() and (greedy["proved_for"] == "none").all()
     # the lexicographic objective is at least −F (every flight flown, none delayed): on these cases the
     # optimum reaches it (regression: greedy does too, −24 and −32), so HiGHS is checked against a value it
     # does not compute, not against greedy, its own warm start

@@ -33,7 +33,7 @@ def plan(turnaround_s: float | None, back_at_s: float = 50.0) -> FlightSet:
 
 def written(tmp_path, flights: FlightSet, delays: tuple[float, float]):
     problem = build_problem(flights, objective="weighted")
-    schedule = make_schedule(problem, "hand", "feasible", np.ones(2, bool), np.array(delays))
+    schedule = make_schedule(problem, "hand", "stopped", np.ones(2, bool), np.array(delays))
     write_schedule(tmp_path / "s", problem, schedule)
     return problem, schedule, verify_dir(tmp_path / "s")
 

@@ -63,7 +63,7 @@ def first_fit(problem, order=None):
 
 def _write(tmp_path, problem, on, delay, name="out"):
     out = tmp_path / name
-    write_schedule(out, problem, make_schedule(problem, "first-fit", "feasible", on, delay))
+    write_schedule(out, problem, make_schedule(problem, "first-fit", "stopped", on, delay))
     return out
 
 

@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from uamopt.checks import expect_path
-from uamopt.errors import InputFileError
+from uamopt.errors import InputFileError, UamoptError
 
 if TYPE_CHECKING:
     from uamopt.planning.network import RouteNetwork
@@ -213,7 +213,7 @@ def load_schedule(path: str | Path) -> Schedule:
     ``summary.json``), rows in schedule.csv order."""
     expect_path(path, "path", "load_schedule")
 
-    from uamopt.schedule.model import Schedule
+    from uamopt.schedule.model import Schedule, status_of, termination_of
 
     file = _file(path, "schedule.csv")
     summary = _json(_file(file.parent, "summary.json"))
@@ -223,8 +223,19 @@ def load_schedule(path: str | Path) -> Schedule:
         operated = np.array([r["operated"].strip() == "1" for r in rows], dtype=bool)
         delay = np.array([float(r["delay_s"]) for r in rows], dtype=float)
         _check_schedule_numbers(delay, summary, file.parent)
+        # a summary written before the statuses were split has only "status"; the pair it stands for
+        try:
+            termination, proved_for = ((summary["termination"], summary["proved_for"]) if "termination" in summary
+                                       else termination_of(summary["status"]))
+            consistent = status_of(termination, proved_for) == summary["status"]
+        except UamoptError as exc:
+            raise InputFileError(exc.what, str(file.parent), "regenerate it with `uamopt schedule`") from None
+        if not consistent:
+            raise InputFileError(f"status {summary['status']!r} does not match termination {termination!r} and "
+                                 f"proved_for {proved_for!r}", str(file.parent), "regenerate it with `uamopt schedule`")
         return Schedule(
-            solver=str(summary["solver"]), status=summary["status"], operated=operated, delay_s=delay,
+            solver=str(summary["solver"]), termination=termination, proved_for=proved_for, operated=operated,
+            delay_s=delay,
             objective=summary.get("objective"), bound=summary.get("bound"), gap=summary.get("gap"),
             solve_seconds=float(summary.get("solve_seconds", 0.0)), seed=summary.get("seed"),
             aircraft_count=int(summary.get("aircraft", 1)), extras=dict(summary.get("extras", {})),

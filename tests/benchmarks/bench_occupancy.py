@@ -121,7 +121,7 @@ def main() -> None:
         problem = build_problem(small, scenario)
         n = problem.n_flights
         with tempfile.TemporaryDirectory() as tmp:
-            write_schedule(tmp, problem, make_schedule(problem, "as-planned", "feasible", np.ones(n, bool), np.zeros(n)))
+            write_schedule(tmp, problem, make_schedule(problem, "as-planned", "stopped", np.ones(n, bool), np.zeros(n)))
             t0 = time.perf_counter()
             found = verify_dir(tmp)
             t_verify = time.perf_counter() - t0

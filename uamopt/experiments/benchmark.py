@@ -34,7 +34,8 @@ from uamopt.experiments.case import error_line, schedule_row, scheduling_problem
 from uamopt.progress import Progress
 
 COLUMNS = ["instance", "flights", "aircraft", "conflicting_pairs", "solver", "profile", "seed", "threads", "time_limit_s",
-           "objective_kind", "status", "model", "objective", "bound", "gap", "operated", "cancelled", "total_delay_s",
+           "objective_kind", "status", "termination", "proved_for", "model", "objective", "bound", "gap", "operated",
+           "cancelled", "total_delay_s",
            "avg_delay_s", "wall_seconds", "solve_seconds", "build_seconds", "verified", "error", "plan_seed", "scenario",
            "set", "trace"]
 

@@ -86,7 +86,7 @@ def risk_metrics(scenario, field) -> dict:
 
 def found_solution(schedule) -> bool:
     """False when the solver stopped without an incumbent (its schedule then cancels everything)."""
-    return schedule.status != "infeasible" and not str(schedule.extras.get("incumbent", "")).startswith("none found")
+    return schedule.found and not str(schedule.extras.get("incumbent", "")).startswith("none found")
 
 
 def schedule_row(problem, schedule, seconds: float) -> dict:
@@ -101,11 +101,12 @@ def schedule_row(problem, schedule, seconds: float) -> dict:
     gap = math.nan
     if solved and math.isfinite(bound) and abs(objective) > 1e-9:
         gap = abs(objective - bound) / abs(objective)
-    return {"status": schedule.status, "model": schedule.extras.get("model_kind"),
+    return {"status": schedule.status, "termination": schedule.termination, "proved_for": schedule.proved_for,
+            "model": schedule.extras.get("model_kind"),
             "objective_kind": problem.objective_kind, "objective": objective, "bound": bound, "gap": gap,
             "operated": schedule.operated_count, "cancelled": schedule.cancelled_count,
             "total_delay_s": schedule.total_delay_s, "avg_delay_s": schedule.avg_delay_s,
-            "verified": schedule.status != "infeasible" and verify(problem, schedule).ok,  # infeasible: no schedule
+            "verified": schedule.found and verify(problem, schedule).ok,  # infeasible / no_solution: no schedule
             "seconds": seconds}
 
 

@@ -44,7 +44,8 @@ RESULTS = "results.parquet"
 
 #: column -> pandas dtype, in table order (the swept keys follow ``case``)
 HEAD = {"case": "str"}
-SCHEDULE = {"solver": "str", "seed": "Int64", "status": "str", "model": "str", "objective_kind": "str", "objective": "float64",
+SCHEDULE = {"solver": "str", "seed": "Int64", "status": "str", "termination": "str", "proved_for": "str",
+            "model": "str", "objective_kind": "str", "objective": "float64",
             "bound": "float64", "gap": "float64", "operated": "Int64", "cancelled": "Int64", "total_delay_s": "float64",
             "avg_delay_s": "float64", "verified": "boolean", "seconds": "float64"}
 PLAN = {"risk_cost": "float64", "transport_cost": "float64", "length_m": "float64", "n_waypoints": "Int64"}
@@ -153,9 +154,10 @@ def part_problem(frame, stage: str, name: str) -> str | None:
     elif solver.notna().any() or seed.notna().any():
         return f"a row has a solver or seed, which stage {stage} has not"
     status = frame["status"]
-    if status.isna().any() or not status.isin((*STATUSES, "ok")).all():
-        bad = status[~status.isin((*STATUSES, "ok"))].iloc[0]
-        return f"status {bad!r} is not one of {', '.join((*STATUSES, 'ok'))}"[:200]
+    words = (*STATUSES, "ok", "error")  # a solver's status, a stage done, a case that failed
+    if status.isna().any() or not status.isin(words).all():
+        bad = status[~status.isin(words)].iloc[0]
+        return f"status {bad!r} is not one of {', '.join(words)}"[:200]
     for column in COUNTS + NOT_NEGATIVE:
         if column in frame.columns and (frame[column].dropna() < 0).any():
             return f"{column} is negative"

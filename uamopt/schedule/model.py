@@ -50,10 +50,62 @@ if TYPE_CHECKING:
     from uamopt.scenario import Scenario
 
 T = TypeVar("T")
-Status = Literal["optimal", "optimal_on_grid", "feasible", "time_limit", "infeasible", "error"]
-#: ``optimal``: proved for the continuous problem (Sec. 4.3); ``optimal_on_grid``: proved only for a
-#: restriction of it (delays on a grid or lattice, ``extras["model_kind"]``), not for continuous delays
-STATUSES = ("optimal", "optimal_on_grid", "feasible", "time_limit", "infeasible", "error")
+#: why the solver stopped, and whether that is a proof (``proved_for`` says of which model):
+#: ``optimal`` proved optimal (the bound meets the objective to 1e-9 relative); ``infeasible`` proved
+#: that no schedule operates the must-operate flights; ``time_limit`` stopped by the limit with a
+#: schedule and no proof; ``stopped`` ended by its own rule (a heuristic's iterations, a gap limit
+#: above 1e-9, a search that stalled) with a schedule and no proof; ``no_solution`` found no schedule
+#: and proved nothing (a heuristic, or an exact solver stopped before its first incumbent).
+#: A Ctrl-C or SIGTERM raises (uamopt.interrupts): no schedule is returned for it.
+Termination = Literal["optimal", "infeasible", "time_limit", "stopped", "no_solution"]
+TERMINATIONS = ("optimal", "infeasible", "time_limit", "stopped", "no_solution")
+#: what a proof is about: ``continuous`` the problem with continuous delays (Sec. 4.3); ``restricted`` a
+#: restriction of it (delays on a grid or lattice, ``extras["model_kind"]``); ``none`` no proof
+ProvedFor = Literal["continuous", "restricted", "none"]
+PROVED_FOR = ("continuous", "restricted", "none")
+#: the one-word status of files and tables, derived from (termination, proved_for) by :func:`status_of`
+#: (no solver stops on a restriction's infeasibility: cpsat and timeindexed hand it to the continuous MILP)
+Status = Literal["optimal", "optimal_on_grid", "feasible", "time_limit", "infeasible", "no_solution"]
+_STATUS_OF = {("optimal", "continuous"): "optimal", ("optimal", "restricted"): "optimal_on_grid",
+              ("infeasible", "continuous"): "infeasible",
+              ("time_limit", "none"): "time_limit", ("stopped", "none"): "feasible",
+              ("no_solution", "none"): "no_solution"}
+STATUSES = tuple(_STATUS_OF.values())
+#: a bound "meets" an objective (a proof of optimality) within these: the MIP solvers' default absolute
+#: gap (HiGHS mip_abs_gap 1e-6) or a relative 1e-9 of float round-off, whichever is larger
+PROOF_ABS = 1e-6
+PROOF_REL = 1e-9
+
+
+def closes(objective: float | None, bound: float | None) -> bool:
+    """Whether ``bound`` meets ``objective`` within :data:`PROOF_ABS` / :data:`PROOF_REL` (a proof)."""
+    if objective is None or bound is None:
+        return False
+    return objective - bound <= max(PROOF_ABS, PROOF_REL * abs(objective))
+
+
+#: the terminations that carry a proof (and only they): ``proved_for`` is not ``none`` exactly for them
+PROOFS = ("optimal", "infeasible")
+
+
+def status_of(termination: str, proved_for: str) -> Status:
+    """The status word of a (termination, proved_for) pair (the table in docs/interfaces.md)."""
+    try:
+        return _STATUS_OF[(termination, proved_for)]  # type: ignore[return-value]
+    except KeyError:
+        raise UamoptError(f"termination '{termination}' with proved_for '{proved_for}' is no valid result",
+                          "a solver's schedule", "optimal needs proved_for continuous or restricted, infeasible "
+                          "proved_for continuous, every other termination proved_for none") from None
+
+
+def termination_of(status: str) -> tuple[Termination, ProvedFor]:
+    """The (termination, proved_for) of a status word (reading a summary.json that has only ``status``)."""
+    for pair, word in _STATUS_OF.items():
+        if word == status:
+            return pair  # type: ignore[return-value]
+    raise UamoptError(f"unknown status '{status}'", "summary.json", f"use one of {', '.join(STATUSES)}")
+
+
 ObjectiveKind = Literal["weighted", "lexicographic", "earliness_tardiness"]
 
 
@@ -259,7 +311,7 @@ class Schedule:
     """What every solver returns (linopy-style result): decisions, status, objective, bound."""
 
     solver: str
-    status: Status
+    termination: Termination  # why it stopped, and whether that is a proof (TERMINATIONS)
     operated: np.ndarray  # c_f, bool (n,)
     delay_s: np.ndarray  # d_f, s (n,); 0 for cancelled flights
     objective: float | None
@@ -270,10 +322,37 @@ class Schedule:
     aircraft_count: int = 1  # G, for Eq. 21
     extras: dict = field(default_factory=dict)  # solver-specific figures (iterations, nodes, ...)
     flight_ids: tuple[str, ...] = ()  # row i of operated/delay_s is flight flight_ids[i]
+    proved_for: ProvedFor = "none"  # what the proof is about (PROVED_FOR); "none" unless termination is a proof
 
     def __post_init__(self) -> None:
-        if self.status not in STATUSES:
-            raise UamoptError(f"unknown status '{self.status}'", f"solver {self.solver}", f"use one of {', '.join(STATUSES)}")
+        if self.termination not in TERMINATIONS:
+            raise UamoptError(f"unknown termination '{self.termination}'", f"solver {self.solver}",
+                              f"use one of {', '.join(TERMINATIONS)}")
+        status_of(self.termination, self.proved_for)  # a consistent pair, or one clear error
+
+    @property
+    def status(self) -> Status:
+        """The one-word status of files and tables (:func:`status_of`): ``optimal`` (proved for continuous
+        delays), ``optimal_on_grid`` (proved for a restriction only), ``feasible`` (a schedule, stopped by
+        the solver's own rule), ``time_limit`` (a schedule, stopped by the limit), ``infeasible`` /
+        (proved: no schedule exists, for continuous delays), ``no_solution`` (none found, nothing proved)."""
+        return status_of(self.termination, self.proved_for)
+
+    @property
+    def found(self) -> bool:
+        """Whether this is a schedule (termination neither ``infeasible`` nor ``no_solution``)."""
+        return self.termination not in ("infeasible", "no_solution")
+
+    @property
+    def continuous_bound(self) -> float | None:
+        """A lower bound valid for continuous delays (the same as ``bound``, which holds only such bounds)."""
+        return self.bound
+
+    @property
+    def restricted_bound(self) -> float | None:
+        """The restricted model's own bound (a delay grid's or lattice's), not valid for continuous delays."""
+        value = self.extras.get("restricted_bound")
+        return None if value is None else float(value)
 
     def raise_for_status(self) -> Schedule:
         """``self``, or :class:`~uamopt.errors.InfeasibleScheduleError` when the status is
@@ -281,13 +360,13 @@ class Schedule:
         solver's reason: ``ua.solve(problem, "highs").raise_for_status()`` for code that wants an
         exception rather than a status (as ``requests``' ``Response.raise_for_status``). Any other
         status, ``time_limit`` included, is a schedule and returns it."""
-        if self.status != "infeasible":
+        if self.found:
             return self
         from uamopt.errors import InfeasibleScheduleError
 
-        proved = self.extras.get("reason")
-        what = (f"the problem is infeasible: {proved}" if proved else
-                "no schedule operating every must-operate flight was found (a heuristic: not a proof)")
+        proved = self.extras.get("reason") or "no schedule operates every must-operate flight"
+        what = (f"the problem is infeasible: {proved}" if self.termination == "infeasible" else
+                "no schedule operating every must-operate flight was found (not a proof)")
         raise InfeasibleScheduleError(what, f"solver {self.solver}",
                                       "pin fewer flights (must_operate) or widen their delay bounds")
 
@@ -334,7 +413,8 @@ class Schedule:
                                                    "optimal_within", "restricted_bound")
                  if key in self.extras}
         return {
-            "solver": self.solver, "status": self.status, "objective": self.objective, "bound": self.bound,
+            "solver": self.solver, "status": self.status, "termination": self.termination,
+            "proved_for": self.proved_for, "objective": self.objective, "bound": self.bound,
             "gap": self.gap, **named, "operated": self.operated_count, "cancelled": self.cancelled_count,
             "total_delay_s": self.total_delay_s, "avg_delay_s": self.avg_delay_s,
             "solve_seconds": self.solve_seconds, "seed": self.seed,
@@ -342,17 +422,20 @@ class Schedule:
 
 
 def make_schedule(
-    problem: SchedulingProblem, solver: str, status: Status, operated: np.ndarray, delay_s: np.ndarray, *,
-    bound: float | None = None, solve_seconds: float = 0.0, seed: int | None = None, extras: dict | None = None,
+    problem: SchedulingProblem, solver: str, termination: Termination, operated: np.ndarray, delay_s: np.ndarray, *,
+    proved_for: ProvedFor = "none", bound: float | None = None, solve_seconds: float = 0.0, seed: int | None = None,
+    extras: dict | None = None,
 ) -> Schedule:
-    """A :class:`Schedule` with the objective evaluated and the relative gap |obj − bound| / |obj|."""
+    """A :class:`Schedule` with the objective evaluated and the relative gap |obj − bound| / |obj|
+    (``proved_for`` must name the model when ``termination`` is a proof, :data:`PROOFS`)."""
     c = np.asarray(operated, dtype=bool).copy()
     d = np.where(c, np.asarray(delay_s, dtype=float), 0.0)
-    objective = evaluate(problem, c, d) if status != "infeasible" else None
+    objective = evaluate(problem, c, d) if termination not in ("infeasible", "no_solution") else None
     gap = None
     if objective is not None and bound is not None:
         gap = abs(objective - bound) / max(abs(objective), 1e-10)
-    return Schedule(solver=solver, status=status, operated=c, delay_s=d, objective=objective, bound=bound, gap=gap,
+    return Schedule(solver=solver, termination=termination, proved_for=proved_for, operated=c, delay_s=d,
+                    objective=objective, bound=bound, gap=gap,
                     solve_seconds=solve_seconds, seed=seed, aircraft_count=problem.aircraft_count, extras=dict(extras or {}),
                     flight_ids=tuple(f.id for f in problem.flights.flights))
 

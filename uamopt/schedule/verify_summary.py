@@ -17,6 +17,13 @@ from uamopt.bounds import MAX_WEIGHT, outside_grid
 from uamopt.errors import InputFileError
 
 TOL_S = 1e-6  # tolerance on every time and total, s (relative above 1)
+#: each status word and the (termination, proved_for) it stands for (docs/interfaces.md, *Statuses*),
+#: written out here, not imported: the verifier shares nothing with the code that wrote the files
+STATUS_WORDS = {"optimal": ("optimal", "continuous"), "optimal_on_grid": ("optimal", "restricted"),
+                "infeasible": ("infeasible", "continuous"),
+                "time_limit": ("time_limit", "none"), "feasible": ("stopped", "none"),
+                "no_solution": ("no_solution", "none")}
+NO_SCHEDULE = ("infeasible", "no_solution")  # statuses that carry no schedule
 
 
 def shown(value, limit: int = 40) -> str:
@@ -71,7 +78,7 @@ def check_summary(path: Path, spec: dict, flown: list[dict], n_aircraft: int) ->
     out += check_families(summary, spec, flown, str(path))
     if objective_checked_here(summary):
         pass  # against the instance file or the speed choice (verify_variants.py)
-    elif summary.get("status") != "infeasible" and summary.get("objective") is not None and "weights" in summary:
+    elif summary.get("status") not in NO_SCHEDULE and summary.get("objective") is not None and "weights" in summary:
         w6, w7 = read_weights(summary["weights"], str(path))
         if summary.get("objective_kind", "weighted") == "weighted":
             expect["objective"] = w6 * per_aircraft - w7 * len(flown)
@@ -87,8 +94,15 @@ def check_summary(path: Path, spec: dict, flown: list[dict], n_aircraft: int) ->
         got = summary.get(key)
         if not finite(got) or not close(float(got), float(value)):
             out.append(f"summary.json: {key} = {shown(got)}, the schedule gives {value:.6g}")
-    if summary.get("status") not in ("optimal", "optimal_on_grid", "feasible", "time_limit", "infeasible", "error"):
-        out.append(f"summary.json: unknown status {shown(summary.get('status'))}")
+    status = summary.get("status")
+    if status not in STATUS_WORDS:
+        out.append(f"summary.json: unknown status {shown(status)}")
+    elif "termination" in summary or "proved_for" in summary:  # written since the statuses were split (issue 40)
+        pair = (summary.get("termination"), summary.get("proved_for"))
+        if STATUS_WORDS[status] != pair:
+            out.append(f"summary.json: status {status} with termination {shown(pair[0])} and proved_for "
+                       f"{shown(pair[1])}; {status} means termination {STATUS_WORDS[status][0]}, proved_for "
+                       f"{STATUS_WORDS[status][1]}")
     return out
 
 

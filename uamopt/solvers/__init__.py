@@ -211,7 +211,7 @@ def solve(problem: SchedulingProblem, profile: SolverProfile | str, *, extra=Non
                                        gap=abs(schedule.objective - bound) / max(abs(schedule.objective), 1e-10))
     # the progress over time (watchdog.trace_of; a heuristic's is its answer alone), ending at the answer
     final = [round(float(schedule.solve_seconds), 3),
-             float(schedule.objective) if schedule.status != "infeasible" and schedule.objective is not None else None,
+             float(schedule.objective) if schedule.found and schedule.objective is not None else None,
              float(schedule.bound) if schedule.bound is not None and math.isfinite(schedule.bound) else None]
     schedule.extras["trace"] = [*schedule.extras.get("trace", []), final]
     return schedule
@@ -268,7 +268,7 @@ def _speed_solve(problem, profile, module, choice):
     t0 = time.perf_counter()
     base_profile = dataclasses.replace(profile, time_limit_s=SPEED_BASE_SHARE * profile.time_limit_s)
     first = module.solve(choice.base_problem, base_profile)
-    lifted = choice.lift(first.operated, first.delay_s) if first.status != "infeasible" else None
+    lifted = choice.lift(first.operated, first.delay_s) if first.found else None
     left = max(0.1, profile.time_limit_s - (time.perf_counter() - t0))
     if lifted is not None:
         SEEDS[id(problem)] = [("cruise-speed model", *lifted)]

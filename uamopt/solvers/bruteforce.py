@@ -169,7 +169,7 @@ def solve(problem: SchedulingProblem, profile: SolverProfile | None = None) -> S
         if found is not None and found[0] - objective.per_flight * int(c.sum()) < best_value:
             best_value, best = found[0] - objective.per_flight * int(c.sum()), (c, found[1])
     if best is None:  # only with must-operate flights: cancelling every other flight is always feasible
-        return make_schedule(problem, "bruteforce", "infeasible", np.zeros(n, bool), np.zeros(n),
+        return make_schedule(problem, "bruteforce", "infeasible", np.zeros(n, bool), np.zeros(n), proved_for="continuous",
                              solve_seconds=time.perf_counter() - start, extras={"vectors": len(vectors)})
-    return make_schedule(problem, "bruteforce", "optimal", best[0], best[1], bound=best_value,
+    return make_schedule(problem, "bruteforce", "optimal", best[0], best[1], proved_for="continuous", bound=best_value,
                          solve_seconds=time.perf_counter() - start, extras={"vectors": len(vectors)})

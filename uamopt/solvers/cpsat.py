@@ -46,7 +46,7 @@ import numpy as np
 from uamopt.errors import UamoptError
 from uamopt.interrupts import stopping
 from uamopt.schedule.flights import TIME_TOL_S
-from uamopt.schedule.model import Schedule, SchedulingProblem, Status, make_schedule
+from uamopt.schedule.model import ProvedFor, Schedule, SchedulingProblem, Termination, closes, evaluate, make_schedule
 from uamopt.solvers.watchdog import report_incumbent, watched
 
 if TYPE_CHECKING:
@@ -56,7 +56,6 @@ if TYPE_CHECKING:
 
 ROUND_S = 1e-9  # float round-off accepted when rounding a real time to units, s
 INT_LIMIT = 2**62  # keep |objective| below this (CP-SAT uses int64)
-CERTIFIED_GAP = 1e-9  # objective − continuous bound, relative, at which a lattice optimum is called optimal (round-off only)
 
 
 def integer_objective(problem: SchedulingProblem, unit_s: float, delay_max: np.ndarray) -> tuple[int, int, float, str]:
@@ -387,7 +386,7 @@ def solve(problem: SchedulingProblem, profile: SolverProfile, extra=None) -> Sch
         code = solver.solve(model, _reporter(problem, operate, delay, unit_s)) if watched(problem) else solver.solve(model)
     seconds = time.perf_counter() - t0
     n = problem.n_flights
-    extras = {"termination": solver.status_name(code), "time_unit_s": unit_s, "objective_scale": how,
+    extras = {"engine_termination": solver.status_name(code), "time_unit_s": unit_s, "objective_scale": how,
               "model": f"delay lattice {unit_s:g} s, constraints rounded outward (a restriction of the continuous model)",
               "branches": int(solver.num_branches), "warm_start": f"{start.source} {start.objective:.6f}",
               "build_seconds": build_s}
@@ -395,9 +394,18 @@ def solve(problem: SchedulingProblem, profile: SolverProfile, extra=None) -> Sch
         why = model.validate() or solver.solution_info()
         raise UamoptError(f"CP-SAT rejected the run: {why}", f"profile {profile.name or 'cpsat'}",
                           "check the profile's [options]" if not model.validate() else "report this as a bug")
-    if code == cp_model.INFEASIBLE:
+    if code == cp_model.INFEASIBLE and not lattice_is_exact(problem, unit_s, how):
+        # a proof for the lattice model, a restriction: the continuous MILP (milp.py) decides, in the time left
+        from uamopt.solvers import milp
+
+        left = max(0.1, profile.time_limit_s - (time.perf_counter() - t0))
+        proof = milp.solve(problem, dataclasses.replace(profile, solver="highs", time_limit_s=left, options={}))
+        return dataclasses.replace(proof, solver="cpsat", solve_seconds=time.perf_counter() - t0, extras={
+            **extras, **proof.extras, "lattice": "infeasible on the lattice; the continuous MILP (highs) decided"})
+    if code == cp_model.INFEASIBLE:  # the lattice is exact: a proof for continuous delays
         extras["reason"] = infeasible_reason(problem)
-        return make_schedule(problem, "cpsat", "infeasible", np.zeros(n, bool), np.zeros(n), solve_seconds=seconds,
+        return make_schedule(problem, "cpsat", "infeasible", np.zeros(n, bool), np.zeros(n), proved_for="continuous",
+                             solve_seconds=seconds,
                              seed=profile.seed, extras=extras)
     if code == cp_model.UNKNOWN and not start.found:
         raise no_schedule(problem, profile.name or "cpsat", "CP-SAT stopped at its limit with no incumbent")
@@ -411,11 +419,15 @@ def solve(problem: SchedulingProblem, profile: SolverProfile, extra=None) -> Sch
     # below closes the gap; the lattice bound is no bound of the continuous problem (extras only).
     # When the lattice is exact (the data, not the dominance caps of `small`), its optimum and bound are the continuous ones.
     exact = lattice_is_exact(problem, unit_s, how)
-    status: Status = (("optimal" if exact else "optimal_on_grid") if code == cp_model.OPTIMAL
-                      else "time_limit")  # FEASIBLE: the limit
+    # OPTIMAL within a relative_gap_limit above round-off is CP-SAT's gap rule (stopped), not a proof
     lattice_bound = objective_bound(problem, solver.best_objective_bound, per_flight, divisor, unit_s, how)
+    lattice_value = evaluate(problem, operated, delay_s)
+    termination: Termination = "time_limit"  # FEASIBLE: the limit
+    if code == cp_model.OPTIMAL:
+        termination = "optimal" if closes(lattice_value, lattice_bound) else "stopped"
+    proved_for: ProvedFor = ("continuous" if exact else "restricted") if termination == "optimal" else "none"
     extras.update(restricted_bound=lattice_bound, lattice_exact=exact)
-    schedule = no_worse(problem, make_schedule(problem, "cpsat", status, operated, delay_s,
+    schedule = no_worse(problem, make_schedule(problem, "cpsat", termination, operated, delay_s, proved_for=proved_for,
                                                bound=lattice_bound if exact else None,
                                                solve_seconds=seconds, seed=profile.seed, extras=extras), start)
     assert schedule.objective is not None, "only an infeasible schedule has no objective (make_schedule)"
@@ -438,10 +450,11 @@ def solve(problem: SchedulingProblem, profile: SolverProfile, extra=None) -> Sch
             schedule.extras.update(continuous_bound=low, continuous_bound_termination=relaxed.status_name(r_code),
                                    continuous_bound_model=f"delay cells {unit_s:g} s (relaxation of the continuous model)",
                                    optimal_within=schedule.objective - low)
-            status = schedule.status
-            if status == "optimal_on_grid" and schedule.objective - low <= CERTIFIED_GAP * max(1.0, abs(low)):
-                status = "optimal"  # the continuous bound meets the lattice optimum: optimal for continuous delays
+            termination, proved_for = schedule.termination, schedule.proved_for
+            if closes(schedule.objective, low):  # the continuous bound meets the lattice's schedule: proved for continuous
+                termination, proved_for = "optimal", "continuous"
             bound = low if schedule.bound is None else max(low, schedule.bound)  # both valid: the larger
-            schedule = make_schedule(problem, "cpsat", status, schedule.operated, schedule.delay_s, bound=bound,
+            schedule = make_schedule(problem, "cpsat", termination, schedule.operated, schedule.delay_s,
+                                     proved_for=proved_for, bound=bound,
                                      solve_seconds=schedule.solve_seconds, seed=profile.seed, extras=schedule.extras)
     return dataclasses.replace(schedule, solve_seconds=time.perf_counter() - t0)

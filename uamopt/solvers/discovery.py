@@ -550,6 +550,6 @@ def solve(problem: SchedulingProblem, profile) -> Schedule:
               "warm_start": f"{start.source} {start.objective:.6f}",
               "continuous_bound": found.bound, "continuous_bound_model": found.model}
     schedule = make_schedule(problem, "discovery", "optimal" if proved else "time_limit", operated, delay,
-                             bound=found.bound, solve_seconds=time.perf_counter() - t0, seed=profile.seed,
-                             extras=extras)
+                             proved_for="continuous" if proved else "none", bound=found.bound,
+                             solve_seconds=time.perf_counter() - t0, seed=profile.seed, extras=extras)
     return no_worse(problem, schedule, start)

@@ -39,7 +39,8 @@ mutation_rate (0.3, per child), multi_points (4, genes of a multi-point mutation
 drawing the cancel allele), elite_fraction (0.1), t0 (100), xi (0.99), t_final (0.1),
 fitness_scale (100), step_s (ΔT_a = 10 s), exact_gaps (false). ``profile.seed`` seeds a numpy
 Generator (same seed, same result, unless the time limit cuts the run); ``profile.time_limit_s``
-is checked between generations (status "time_limit" when it stopped the run, else "feasible").
+is checked between generations (termination ``time_limit`` when it stopped the run, else ``stopped``, status "feasible";
+``no_solution`` when a must-operate flight is left out).
 """
 
 from __future__ import annotations
@@ -54,7 +55,7 @@ import numpy as np
 
 from uamopt.bounds import MAX_TIME_S, Range, check_number, shown
 from uamopt.errors import UamoptError
-from uamopt.schedule.model import Schedule, SchedulingProblem, Status, make_schedule
+from uamopt.schedule.model import Schedule, SchedulingProblem, Termination, make_schedule
 from uamopt.solvers.greedy import (  # noqa: F401  (SHAPES, OBJECTIVES: the decoder's, uamopt.solvers.check_supported)
     CANCEL,
     DEFAULT_STEP_S,
@@ -299,7 +300,7 @@ def solve(problem: SchedulingProblem, profile: SolverProfile) -> Schedule:
               "greedy_objective": float(w[0]), "history": best.history}
     if profile.solver == "soa":
         extras["final_temperature"] = opts.t0 * opts.xi ** max(generations - 1, 0)
-    status: Status = ("infeasible" if np.any(problem.must_operate & ~best.operated)
-              else "time_limit" if timed_out else "feasible")
-    return make_schedule(problem, profile.solver, status, best.operated, best.delay,
+    termination: Termination = ("no_solution" if np.any(problem.must_operate & ~best.operated)
+                                else "time_limit" if timed_out else "stopped")
+    return make_schedule(problem, profile.solver, termination, best.operated, best.delay,
                          solve_seconds=time.perf_counter() - start, seed=profile.seed, extras=extras)

@@ -36,7 +36,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from uamopt.schedule.model import Schedule, SchedulingProblem, Status, make_schedule
+from uamopt.schedule.model import Schedule, SchedulingProblem, Termination, make_schedule
 
 if TYPE_CHECKING:
     from uamopt.solvers import SolverProfile
@@ -250,11 +250,12 @@ def base_genes(problem: SchedulingProblem, step_s: float) -> np.ndarray:
 
 
 def solve(problem: SchedulingProblem, profile: SolverProfile) -> Schedule:
-    """The preliminary strategy as a solver: status "feasible" (``infeasible`` when a must-operate
-    flight cannot be placed), no bound."""
+    """The preliminary strategy as a solver: termination ``stopped`` (status "feasible";
+    ``no_solution`` when a must-operate flight cannot be placed: a heuristic proves nothing), no bound."""
     step_s, exact = profile.option("step_s", problem.time_step_s), profile.option("exact_gaps")
     start = time.perf_counter()
     operated, delay = greedy_decisions(problem, step_s, exact)
-    status: Status = "infeasible" if np.any(problem.must_operate & ~operated) else "feasible"
-    return make_schedule(problem, "greedy", status, operated, delay, solve_seconds=time.perf_counter() - start,
+    # a must-operate flight not placed: no schedule, and no proof that none exists (a heuristic)
+    termination: Termination = "no_solution" if np.any(problem.must_operate & ~operated) else "stopped"
+    return make_schedule(problem, "greedy", termination, operated, delay, solve_seconds=time.perf_counter() - start,
                          seed=profile.seed, extras={"step_s": step_s, "exact_gaps": exact})

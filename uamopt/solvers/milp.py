@@ -58,7 +58,7 @@ from pyomo.contrib.solver.common.results import SolutionStatus, TerminationCondi
 from uamopt.errors import UamoptError
 from uamopt.interrupts import quiet_on_interrupt, stopping
 from uamopt.schedule.flights import TIME_TOL_S
-from uamopt.schedule.model import Schedule, SchedulingProblem, Status, make_schedule
+from uamopt.schedule.model import Schedule, SchedulingProblem, Termination, closes, make_schedule
 from uamopt.solvers.highs import interrupt_at, start_solution
 from uamopt.solvers.watchdog import report_bound, report_incumbent, watched
 
@@ -413,10 +413,12 @@ def mip_start(m: pyo.ConcreteModel, problem: SchedulingProblem, operated: np.nda
 def solve(problem: SchedulingProblem, profile: SolverProfile, extra=None) -> Schedule:
     """Build and solve the MILP with HiGHS; a linopy-style status, never an exception on a limit.
 
-    Status: ``optimal`` (proved, within ``mip_rel_gap``), ``time_limit`` (limit hit; the incumbent
-    with HiGHS's bound), ``infeasible``. HiGHS starts from the best cheap heuristic schedule
-    (:func:`~uamopt.solvers.warmstart.warm_start`, a MIP start through ``Highs.setSolution``) and
-    never returns a worse one (:func:`~uamopt.solvers.warmstart.no_worse`). The model is built on
+    Termination: ``optimal`` (HiGHS's bound meets its objective, :func:`~uamopt.schedule.model.closes`),
+    ``stopped`` (HiGHS met a ``mip_rel_gap`` above that: no proof), ``time_limit`` (limit hit; the
+    incumbent with HiGHS's bound), ``infeasible`` (proved, for continuous delays). HiGHS starts from
+    the best cheap heuristic schedule (:func:`~uamopt.solvers.warmstart.warm_start`, a MIP start
+    through ``Highs.setSolution``) and never returns a worse one
+    (:func:`~uamopt.solvers.warmstart.no_worse`). The model is built on
     :func:`~uamopt.solvers.warmstart.reduced` (dominated delays cut off; the optima are unchanged).
     """
     from uamopt.solvers.warmstart import infeasible_reason, no_schedule, no_start, no_worse, reduced, warm_start
@@ -458,21 +460,22 @@ def solve(problem: SchedulingProblem, profile: SolverProfile, extra=None) -> Sch
             result = solver.solve(m, time_limit=left, threads=int(profile.threads), solver_options=options,
                                   load_solutions=False, raise_exception_on_nonoptimal_result=False)
     tc, has_solution = result.termination_condition, result.solution_status in (SolutionStatus.optimal, SolutionStatus.feasible)
-    extras = {"termination": tc.name, "nodes": getattr(result.extra_info, "mip_node_count", None),
+    extras = {"engine_termination": tc.name, "nodes": getattr(result.extra_info, "mip_node_count", None),
               "highs_objective": result.incumbent_objective, "highs_seconds": result.timing_info.highs_time,
               "build_seconds": build_s}
     bound = result.objective_bound if result.objective_bound is not None and np.isfinite(result.objective_bound) else None
     n = problem.n_flights
     if tc in (TerminationCondition.provenInfeasible, TerminationCondition.infeasibleOrUnbounded):
         extras["reason"] = infeasible_reason(problem)
-        return make_schedule(problem, "highs", "infeasible", np.zeros(n, bool), np.zeros(n),
+        return make_schedule(problem, "highs", "infeasible", np.zeros(n, bool), np.zeros(n), proved_for="continuous",
                              solve_seconds=time.perf_counter() - t0, seed=profile.seed, extras=extras)
-    status: Status
+    termination: Termination
     if tc == TerminationCondition.convergenceCriteriaSatisfied and has_solution:
-        status = "optimal"
+        # HiGHS stops at mip_rel_gap: optimal only when its bound meets its objective (to 1e-9), else its gap rule
+        termination = "optimal" if closes(result.incumbent_objective, bound) else "stopped"
     elif tc in (TerminationCondition.maxTimeLimit, TerminationCondition.iterationLimit, TerminationCondition.interrupted
                 ) or (stopped and tc == TerminationCondition.unknown):  # our deadline interrupt (solvers/highs.py)
-        status = "time_limit"
+        termination = "time_limit"
     else:
         raise UamoptError(f"HiGHS stopped with {tc.name} ({_model_status(solver)})", f"solver {profile.name or 'highs'}",
                           "see the HiGHS log (tee=True)")
@@ -494,7 +497,8 @@ def solve(problem: SchedulingProblem, profile: SolverProfile, extra=None) -> Sch
         extras["incumbent"] = "none found: every flight cancelled"
     extras["warm_start"] = f"{start.source} {start.objective:.6f}"
     extras["model"] = MODEL
-    return no_worse(problem, make_schedule(problem, "highs", status, operated, delay, bound=bound,
+    return no_worse(problem, make_schedule(problem, "highs", termination, operated, delay,
+                                           proved_for="continuous" if termination == "optimal" else "none", bound=bound,
                                            solve_seconds=time.perf_counter() - t0, seed=profile.seed, extras=extras), start)
 
 
@@ -518,7 +522,7 @@ def _start_only(problem: SchedulingProblem, profile, start, t0: float, why: str)
 
         raise no_schedule(problem, profile.name or "highs", why)
     return make_schedule(problem, "highs", "time_limit", start.operated, start.delay_s, solve_seconds=time.perf_counter() - t0,
-                         seed=profile.seed, extras={"termination": "not run", "incumbent": why, "model": MODEL,
+                         seed=profile.seed, extras={"engine_termination": "not run", "incumbent": why, "model": MODEL,
                                                     "warm_start": f"{start.source} {start.objective:.6f}"})
 
 

@@ -49,8 +49,10 @@ decisions fixed (``extras["windows_past_limit"]``).
 
 Options (``[options]`` of a profile): ``window_s`` (900), ``inner`` ("cpsat"), ``window_time_limit_s``
 (default ``time_limit_s`` / number of non-empty windows), ``time_unit_s`` (CP-SAT, 0.01),
-``step_s`` (greedy fallback ΔT_a; default the problem's ``schedule.time_step_s``). Status: ``feasible``, or
-``time_limit`` if some window's inner solve stopped at its limit without proof. Registered as
+``step_s`` (greedy fallback ΔT_a; default the problem's ``schedule.time_step_s``). Termination: ``time_limit`` when the
+limit came before the last window, else ``stopped`` (status ``feasible``; windows whose inner solve
+stopped unproved are counted in ``extras["unproved"]``); ``no_solution`` when a must-operate flight
+found no place (a heuristic: no proof). Registered as
 ``"rolling"`` (profile ``solvers/rolling.toml``): ``solve(problem, "rolling")``, or
 ``solve(problem, SolverProfile("rolling", time_limit_s=60, options={"window_s": 600.0}))``.
 """
@@ -66,7 +68,7 @@ import numpy as np
 from uamopt.errors import UamoptError
 from uamopt.interrupts import stopping
 from uamopt.schedule.flights import TIME_TOL_S
-from uamopt.schedule.model import Schedule, SchedulingProblem, Status, make_schedule, violations
+from uamopt.schedule.model import Schedule, SchedulingProblem, Termination, make_schedule, violations
 from uamopt.schedule.occupancy import ConflictTable
 from uamopt.solvers.greedy import greedy_decisions
 
@@ -302,9 +304,11 @@ def solve(problem: SchedulingProblem, profile: SolverProfile) -> Schedule:
         stats["fallback"] = f"whole-problem greedy ({len(bad)} violations, first: {bad[0]})"
         operated, delay = greedy_decisions(problem, o["step_s"] and float(o["step_s"]))
     bound: float | None = pair_matching_bound(problem)
-    status: Status = "time_limit" if stats["unproved"] else "feasible"
+    # the limit reached before the last window: time_limit; else the run ended by its own rule (every window
+    # solved once; an inner window unproved at its share of the limit is counted in extras["unproved"])
+    termination: Termination = "time_limit" if stats.get("windows_past_limit") else "stopped"
     if not first.found and violations(problem, operated, delay):  # as greedy: a must-operate flight not placed
-        status, bound = "infeasible", None
+        termination, bound = "no_solution", None
     stats["bound_of"] = "pair-matching relaxation (rolling.py docstring)"
-    return no_worse(problem, make_schedule(problem, "rolling", status, operated, delay, bound=bound,
+    return no_worse(problem, make_schedule(problem, "rolling", termination, operated, delay, bound=bound,
                                            solve_seconds=time.perf_counter() - start, seed=profile.seed, extras=stats), first)

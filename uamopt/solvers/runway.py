@@ -920,5 +920,6 @@ def solve(problem: SchedulingProblem, profile, runway: Runway):
                             "the windows reduced-cost fixing leaves)", "model_kind": "continuous",
                    "continuous_bound": bound, "neighbourhoods_solved": solved, "neighbourhoods_improved": improved,
                    "exact_in_windows": exact})
-    return make_schedule(problem, "discovery", "optimal" if proved else "time_limit", operated, delay, bound=bound,
+    return make_schedule(problem, "discovery", "optimal" if proved else "time_limit", operated, delay,
+                         proved_for="continuous" if proved else "none", bound=bound,
                          solve_seconds=time.perf_counter() - t0, seed=profile.seed, extras=extras)

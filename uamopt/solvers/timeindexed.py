@@ -62,8 +62,10 @@ model at ``continuous_bound_step_s`` (default ``step_s``), whose bound is report
 rows of cliques.py), ``refine_step_s`` (default 0: none; coarse to fine, :func:`_refine`: 40 % of the
 engine's time on the ``step_s`` grid, the rest on the finer grid started from its best). The summary names the model:
 ``extras["model"]`` = e.g. "delay grid 10 s (exact for delays on the grid)".
-Status: from the engine's own termination — ``optimal`` (proved on the named model),
-``time_limit``; never inferred from elapsed time.
+Termination: from the engine's own — ``optimal`` when its bound meets its schedule (proved on the
+named model: ``proved_for`` ``restricted``, or ``continuous`` when the grid is exact or the relaxed
+cells' bound meets it), ``stopped`` at a ``mip_rel_gap`` above that, ``time_limit``; never inferred
+from elapsed time.
 """
 
 from __future__ import annotations
@@ -79,7 +81,7 @@ import numpy as np
 from uamopt.errors import UamoptError
 from uamopt.interrupts import stopping
 from uamopt.schedule.flights import TIME_TOL_S
-from uamopt.schedule.model import Schedule, SchedulingProblem, Status, evaluate, make_schedule
+from uamopt.schedule.model import ProvedFor, Schedule, SchedulingProblem, Termination, closes, evaluate, make_schedule
 from uamopt.solvers.highs import highs_can_start, mip_solver, run_mip, start_solution
 from uamopt.solvers.warmstart import Start, no_schedule, no_worse, reduced, warm_start
 from uamopt.solvers.watchdog import report_incumbent
@@ -552,7 +554,7 @@ def solve(problem: SchedulingProblem, profile: SolverProfile) -> Schedule:
         step = model.step_s
     else:
         fine_note = None
-    extras = {"model": model_name(kind, step), "engine": engine, "termination": result.termination,
+    extras = {"model": model_name(kind, step), "engine": engine, "engine_termination": result.termination,
               "columns": model.n_cols, "rows": model.n_rows, "cliques": model.cliques,
               "dominated_pair_rows": model.dominated_pair_rows, "build_seconds": round(built, 3),
               "warm_start": f"{start.source} {start.objective:.6f}", "warm_start_s": round(start.seconds, 3),
@@ -570,12 +572,13 @@ def solve(problem: SchedulingProblem, profile: SolverProfile) -> Schedule:
 
         left = max(0.1, profile.time_limit_s - (time.perf_counter() - t0))
         proof = milp.solve(problem, dataclasses.replace(profile, solver="highs", time_limit_s=left, options={}))
-        if proof.status == "infeasible":
+        if proof.status == "infeasible":  # proved for continuous delays
             extras.update(reason=proof.extras.get("reason"), infeasible_proof="the continuous MILP (highs)")
-            return make_schedule(problem, "timeindexed", "infeasible", np.zeros(n, bool), np.zeros(n),
+            return make_schedule(problem, "timeindexed", "infeasible", np.zeros(n, bool), np.zeros(n), proved_for="continuous",
                                  solve_seconds=time.perf_counter() - t0, seed=profile.seed, extras=extras)
         extras.update(grid="infeasible on the grid; schedule from the continuous MILP", model_kind="continuous")
-        return make_schedule(problem, "timeindexed", proof.status, proof.operated, proof.delay_s, bound=proof.bound,
+        return make_schedule(problem, "timeindexed", proof.termination, proof.operated, proof.delay_s,
+                             proved_for=proof.proved_for, bound=proof.bound,
                              solve_seconds=time.perf_counter() - t0, seed=profile.seed, extras={**proof.extras, **extras})
     if not start.found and (kind == "relaxed" or result.x is None):
         raise no_schedule(problem, profile.name or "timeindexed", f"the engine stopped ({result.termination}) with none")
@@ -590,13 +593,15 @@ def solve(problem: SchedulingProblem, profile: SolverProfile) -> Schedule:
     # The grid model is a restriction: "optimal" on it is not optimal for continuous delays, and its
     # bound is no bound of the continuous problem. Status optimal_on_grid; the grid bound is kept in
     # extras["restricted_bound"]; ``bound`` holds only the relaxed model's bound, when computed.
-    status: Status = "optimal_on_grid" if result.proved else "time_limit"
     extras["restricted_bound"] = result.bound
     exact = _grid_is_exact(problem, step)  # every time on the grid: the grid's optimum and bound are the continuous ones
     extras["grid_exact"] = exact
-    if exact and result.proved:
-        status = "optimal"
-    schedule = make_schedule(problem, "timeindexed", status, operated, delay, bound=result.bound if exact else None,
+    # proved: the engine closed its gap (to its tolerance; a gap limit above that is its own rule, no proof)
+    closed = result.proved and result.x is not None and closes(float(model.cost @ np.round(result.x)), result.bound)
+    termination: Termination = "optimal" if closed else "stopped" if result.proved else "time_limit"
+    proved_for: ProvedFor = ("continuous" if exact else "restricted") if closed else "none"
+    schedule = make_schedule(problem, "timeindexed", termination, operated, delay, proved_for=proved_for,
+                             bound=result.bound if exact else None,
                              solve_seconds=time.perf_counter() - t0, seed=profile.seed, extras=extras)
     schedule = no_worse(problem, schedule, start)
     if cont_s > 0:
@@ -622,7 +627,11 @@ def solve(problem: SchedulingProblem, profile: SolverProfile) -> Schedule:
         r = dataclasses.replace(r, bound=schedule.extras["continuous_bound"])
         if r.bound is not None and schedule.objective is not None:
             schedule.extras["optimal_within"] = schedule.objective - r.bound
-        schedule = make_schedule(problem, "timeindexed", schedule.status, schedule.operated, schedule.delay_s,
+        termination, proved_for = schedule.termination, schedule.proved_for
+        if closes(schedule.objective, r.bound):  # the continuous bound meets the grid's schedule
+            termination, proved_for = "optimal", "continuous"
+        schedule = make_schedule(problem, "timeindexed", termination, schedule.operated, schedule.delay_s,
+                                 proved_for=proved_for,
                                  bound=r.bound, solve_seconds=time.perf_counter() - t0, seed=profile.seed,
                                  extras=schedule.extras)
     return schedule

@@ -40,7 +40,7 @@ from uamopt.errors import UamoptError
 from uamopt.schedule.model import (
     Schedule,
     SchedulingProblem,
-    Status,
+    Termination,
     evaluate,
     make_schedule,
     violations,
@@ -179,12 +179,12 @@ def no_worse(problem: SchedulingProblem, schedule: Schedule, start: Start) -> Sc
         return schedule
     extras = dict(schedule.extras, incumbent=f"warm start ({start.source}): the solver's own was "
                   f"{'none' if schedule.objective is None else f'{schedule.objective:.6f}'}")
-    status: Status
-    bound, status = schedule.bound, "time_limit"
-    if schedule.status in ("optimal", "optimal_on_grid"):  # optimal on a restricted model that does not hold the start
-        status = "feasible"
+    termination: Termination
+    bound, termination = schedule.bound, "time_limit"
+    if schedule.termination in ("optimal", "stopped"):  # ended by a proof on a restricted model or a gap rule
+        termination = "stopped"
         if schedule.bound is not None and schedule.bound > start.objective + 1e-9 * (1.0 + abs(start.objective)):
             bound = None  # not a bound of the problem the start solves
             extras["bound_dropped"] = f"{schedule.bound!r}: the optimum of {schedule.extras.get('model', 'its model')}"
-    return make_schedule(problem, schedule.solver, status, *start.decisions, bound=bound,
+    return make_schedule(problem, schedule.solver, termination, *start.decisions, bound=bound,
                          solve_seconds=schedule.solve_seconds, seed=schedule.seed, extras=extras)

@@ -506,7 +506,7 @@ def _after_kill(problem, profile, trace: Trace, seconds) -> Schedule:
     value, source = separable_bound(problem), "the separable bound (every flight at its own best choice)"
     if trace.bound > value:
         value, source = trace.bound, trace.bound_source
-    extras = {"termination": "ended at the time limit by the watchdog",
+    extras = {"engine_termination": "ended at the time limit by the watchdog",
               "watchdog": f"the child process did not answer by {kill_at(profile.time_limit_s):.1f} s "
                           f"(limit {profile.time_limit_s:g} s) and was ended; {trace.reported} schedule(s) reported",
               "incumbent": best[3], "bound_source": source}

@@ -224,6 +224,7 @@ def solve(problem: SchedulingProblem, profile: SolverProfile) -> Schedule:
               "lns_windows_improved": improved,
               "warm_start": f"{start.source} {start.objective:.6f}", "continuous_bound": bound,
               "continuous_bound_model": "sum over windows of discovery relaxations (cross-window rows dropped)"}
-    schedule = make_schedule(problem, "windows", "optimal" if proved else "time_limit", operated, delay, bound=bound,
+    schedule = make_schedule(problem, "windows", "optimal" if proved else "time_limit", operated, delay,
+                             proved_for="continuous" if proved else "none", bound=bound,
                              solve_seconds=time.perf_counter() - t0, seed=profile.seed, extras=extras)
     return no_worse(problem, schedule, start)
