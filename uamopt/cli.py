@@ -83,9 +83,10 @@ def cmd_network(args) -> int:
 def cmd_flights(args) -> int:
     from uamopt.workflows import flights_folder
 
-    problem = flights_folder(_load(args), args.out, args.seed)
+    problem = flights_folder(_load(args), args.out, args.seed, model=args.model)
     print(f"flights: {problem.n_flights} flights, {problem.aircraft_count} aircraft, {len(problem.conflicts)} "
-          f"conflicting pairs -> {Path(args.out) / 'flights.json'}")
+          f"conflicting pairs -> {Path(args.out) / 'flights.json'}"
+          + (f" and {Path(args.out) / f'model.{args.model}'}" if args.model else ""))
     return 0
 
 
@@ -232,8 +233,12 @@ def build_parser() -> argparse.ArgumentParser:
     plan.add_argument("--to", dest="destination", metavar="X,Y,Z|NAME",
                       help="destination, m, or a vertiport name (default: tracks.route / tracks.destination)")
     command("network", cmd_network, "plan one track per route and direction: network.json, network.png", "out/network")
-    flight_sources(command("flights", cmd_flights, "generate the scenario's flight plan: flights.json (the instance "
-                           "generator)", "out/flights", figures=False), seed_only=True)
+    flights = command("flights", cmd_flights, "generate the scenario's flight plan: flights.json (the instance "
+                      "generator)", "out/flights", figures=False)
+    flight_sources(flights, seed_only=True)
+    flights.add_argument("--model", choices=("mps", "lp"),
+                         help="also write the exact MILP as model.mps or model.lp, with model.*.columns.json mapping "
+                              "its variables to the flights (for any MILP solver; docs/interfaces.md)")
     sched = command("schedule", cmd_schedule, "schedule the flights: flights.json, schedule.csv, summary.json",
                     "out/schedule", figures=False)
     sched.add_argument("--solver", required=True, metavar="PROFILE", help="solver profile: solvers/NAME.toml or NAME")

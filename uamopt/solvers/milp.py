@@ -289,7 +289,7 @@ def least_delays(problem: SchedulingProblem, operated: np.ndarray, chosen: dict[
     """The least delays (minimal Σ d) of the operated flights for fixed gap choices, or None if none fit.
 
     ``chosen`` maps a pair's row in ``admissible_gaps`` to its gap [g, h]; ``orders`` adds edges
-    (i, j, w): dep_j ≥ dep_i + w (the pads' chosen orders, :func:`_orders`). Bellman-Ford longest
+    (i, j, w): dep_j ≥ dep_i + w (the pads' chosen orders, :func:`pad_orders`). Bellman-Ford longest
     path on dep_j ≥ dep_i + w from d = 0; at most n rounds, vectorised over the edges.
     """
     dep, upper, t = problem.planned_departure_s, problem.delay_upper_s, problem.turnaround
@@ -373,7 +373,7 @@ def chosen_gaps(m: pyo.ConcreteModel, operated: np.ndarray) -> dict[int, tuple[f
     return chosen
 
 
-def _orders(m: pyo.ConcreteModel, operated: np.ndarray) -> list[tuple[int, int, float]]:
+def pad_orders(m: pyo.ConcreteModel, operated: np.ndarray) -> list[tuple[int, int, float]]:
     """The pads' orders the MILP chose between operated flights, as edges dep_j ≥ dep_i + w."""
     out = []
     for k, (f, g, o_a, l_a, o_b, l_b, _, _) in enumerate(getattr(m, "pad_rows", ())):
@@ -483,7 +483,7 @@ def solve(problem: SchedulingProblem, profile: SolverProfile, extra=None) -> Sch
     if has_solution:
         result.solution_loader.load_vars()
         operated = np.array([pyo.value(m.operate[f]) > 0.5 for f in range(n)])
-        chosen, orders = chosen_gaps(m, operated), _orders(m, operated)
+        chosen, orders = chosen_gaps(m, operated), pad_orders(m, operated)
         polished = (least_delays(problem, operated, chosen, orders) if not problem.objective.per_flight_terms
                     else least_cost_delays(problem, operated, chosen, orders))
         if extra is not None and polished is not None:  # rows of the callback the polishing does not know
