@@ -17,7 +17,7 @@ import uamopt as ua
 from uamopt.schedule import Flight, FlightSet, build_problem
 from uamopt.solvers import bruteforce
 
-EXACT = ["highs", "cpsat", "timeindexed", "exact"]
+EXACT = ["highs", "cpsat", "timeindexed", "exact", "scip"]
 HEURISTICS = ["greedy", "ga", "soa", "rolling"]
 
 

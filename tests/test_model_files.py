@@ -21,9 +21,9 @@ from oracles import broken, exact_optimum, model_data, score
 from strategies import tiny_problems
 
 from uamopt.errors import InputFileError, UamoptError
-from uamopt.export.model_files import columns_path, read_solution, write_model
 from uamopt.schedule import write_schedule
 from uamopt.schedule.verify import verify_dir
+from uamopt.solvers.model_files import columns_path, read_solution, write_model
 
 OBJ_TOL = 1e-6
 

@@ -26,7 +26,7 @@ from uamopt.schedule.verify import verify_dir
 from uamopt.solvers import SolverProfile, bruteforce, solve
 
 OBJ_TOL = 1e-6
-EXACT = ["highs", "cpsat", "timeindexed", "exact", "discovery", "bruteforce"]  # profiles, and the oracle solver
+EXACT = ["highs", "cpsat", "timeindexed", "exact", "discovery", "scip", "bruteforce"]  # profiles, and the oracle solver
 HEURISTICS = ["greedy", "ga", "soa", "rolling"]
 
 

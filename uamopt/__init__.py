@@ -52,7 +52,7 @@ _LAZY = {
     "read_airland": "uamopt.schedule.airland", "Objective": "uamopt.schedule.core",
     "load_risk": "uamopt.io", "load_tracks": "uamopt.io", "load_network": "uamopt.io",
     "load_flights": "uamopt.io", "load_schedule": "uamopt.io",
-    "write_model": "uamopt.export.model_files", "read_solution": "uamopt.export.model_files",
+    "write_model": "uamopt.solvers.model_files", "read_solution": "uamopt.solvers.model_files",
     # experiments: not modules of these names, so that importing one never shadows the function
     "sweep": "uamopt.experiments.engine", "load_sweep": "uamopt.experiments.spec",
     "plot_sweep": "uamopt.plotting.sweeps", "benchmark": "uamopt.experiments.benchmark",

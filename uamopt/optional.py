@@ -37,6 +37,7 @@ MODULES = {
     "pyarrow": ("sweep", "a sweep's results.parquet"),
     "plotly": ("view", "uamopt view (the 3-D view)"),
     "bluesky": ("sim", "uamopt replay (BlueSky)"),
+    "pyscipopt": ("scip", "the SCIP solver (profile scip)"),
 }
 
 

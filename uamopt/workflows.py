@@ -99,7 +99,7 @@ def network_folder(scenario: Scenario, out: str | Path, figures: bool = True):
 def flights_folder(scenario: Scenario, out: str | Path, seed: int | None = None, model: str | None = None):
     """``uamopt flights``: the generated plan as a self-contained flights.json (instance generator);
     with ``model`` ("mps" or "lp") also the exact MILP as ``model.mps`` / ``model.lp`` and its
-    variable mapping (uamopt/export/model_files.py), for any MILP solver."""
+    variable mapping (uamopt/solvers/model_files.py), for any MILP solver."""
     from uamopt.outputs import check_out_dir, staged_output, write_json
     from uamopt.pipeline import build_problem, scenario_flights
     from uamopt.schedule import save_flights
@@ -111,7 +111,7 @@ def flights_folder(scenario: Scenario, out: str | Path, seed: int | None = None,
         problem = build_problem(flights, scenario)
         save_flights(stage / "flights.json", flights)
         if model is not None:
-            from uamopt.export.model_files import write_model
+            from uamopt.solvers.model_files import write_model
 
             write_model(problem, stage / f"model.{model}")
         write_json(stage / "summary.json", {

@@ -13,7 +13,6 @@ from uamopt.lazy import lazy_getattr
 #: public name -> module (imported on first access, PEP 562: ``uamopt --help`` loads none of them)
 _LAZY = {"export_bluesky": "uamopt.export.bluesky", "LocalFrame": "uamopt.export.frame",
          "scenario_frame": "uamopt.export.frame", "export_geojson": "uamopt.export.geojson",
-         "Trajectory": "uamopt.export.trajectory", "flyable_trajectory": "uamopt.export.trajectory",
-         "write_model": "uamopt.export.model_files", "read_solution": "uamopt.export.model_files"}
+         "Trajectory": "uamopt.export.trajectory", "flyable_trajectory": "uamopt.export.trajectory"}
 __all__ = sorted(_LAZY)
 __getattr__ = lazy_getattr(__name__, _LAZY)

@@ -43,6 +43,7 @@ SOLVERS = {
     "timeindexed": "uamopt.solvers.timeindexed",
     "discovery": "uamopt.solvers.discovery",
     "windows": "uamopt.solvers.windows",
+    "scip": "uamopt.solvers.scip",
 }
 #: the shipped profiles (package data, read with importlib.resources: :func:`uamopt.shipped.profiles_dir`)
 PROFILE_DIR = profiles_dir()
@@ -152,13 +153,18 @@ def unsupported(module, problem: SchedulingProblem) -> str | None:
 
 
 #: the packages of the [exact] extra each exact solver imports (on use: looked up, not imported, up front)
-NEEDS = {"highs": ("pyomo",), "cpsat": ("ortools",), "rolling": ("ortools", "pyomo"), "timeindexed": ("ortools",)}
+NEEDS = {"highs": ("pyomo",), "cpsat": ("ortools",), "rolling": ("ortools", "pyomo"), "timeindexed": ("ortools",),
+         "scip": ("pyomo", "pyscipopt")}
+#: the extra that brings a solver's packages, where it is not [exact]
+EXTRA_OF = {"scip": "scip"}
 
 
 def solver_module(solver: str):
     """The module of ``solver`` (:data:`SOLVERS`; the enumeration oracle for any other name); a
     solver whose package is an extra not installed is a :class:`~uamopt.optional.MissingExtraError`."""
-    require(*NEEDS.get(solver, ()), extra="exact", what=f"the {solver} solver")
+    for module in NEEDS.get(solver, ()):
+        require(module, extra=EXTRA_OF.get(solver, "exact") if module == "pyscipopt" else "exact",
+                what=f"the {solver} solver")
     try:
         return importlib.import_module(SOLVERS[solver] if solver in SOLVERS else BRUTEFORCE)
     except ModuleNotFoundError as exc:

@@ -73,6 +73,7 @@ SECONDS = Range(0.0, MAX_TIME_S)
 OWN: dict[str, dict[str, Opt]] = {
     "greedy": {"step_s": POSITIVE_S, "exact_gaps": Opt(bool, False)},
     "highs": {},
+    "scip": {"mip_rel_gap": Opt(float, 0.0, valid=Range(0.0, 1.0))},
     "cpsat": {"time_unit_s": Opt(float, 0.01, valid=Range(1e-6, MAX_TIME_S)), "continuous_bound": Opt(bool, True)},
     "rolling": {"window_s": Opt(float, 900.0, valid=Range(1.0, MAX_TIME_S)),
                 "inner": Opt(str, "cpsat", choices=("cpsat", "highs")),

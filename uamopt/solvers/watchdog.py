@@ -56,7 +56,7 @@ MARGIN_SHARE, MARGIN_S = 0.05, 5.0
 #: ending it and making the answer here
 KILL_SHARE, KILL_S = 0.03, 2.0
 #: the solvers run in a child process (the heuristics keep time in Python, between their own steps)
-WATCHED = frozenset({"highs", "cpsat", "timeindexed", "discovery", "rolling"})
+WATCHED = frozenset({"highs", "cpsat", "timeindexed", "discovery", "rolling", "scip"})
 #: imported by the forkserver once, so that a child starts with them loaded
 PRELOAD = ["numpy", "scipy.sparse", "scipy.optimize", "highspy", "pyomo.environ", "ortools.sat.python.cp_model",
            "uamopt.schedule.model", "uamopt.solvers.milp", "uamopt.solvers.cpsat", "uamopt.solvers.timeindexed",

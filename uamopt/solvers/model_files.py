@@ -52,11 +52,19 @@ def columns_path(model_path: str | Path) -> Path:
 def write_model(problem: SchedulingProblem, path: str | Path) -> tuple[Path, Path]:
     """Write the exact MILP of ``problem`` to ``path`` (.mps or .lp) and its variable mapping beside it;
     returns (model file, mapping file). Both are written whole or not at all."""
+    import pyomo.environ as pyo
+
     from uamopt.solvers.milp import build_model
 
     path = Path(path)
     fmt = _format(path)
     model = build_model(problem)
+    for var in model.component_data_objects(pyo.Var):  # a fixed column (must_operate) would vanish from the
+        if var.fixed:                                   # file as a constant: kept as a column of equal bounds
+            value = var.value
+            var.unfix()
+            var.setlb(value)
+            var.setub(value)
     names = {}
     tmp = path.with_name(path.name + ".part")
     try:
@@ -153,47 +161,61 @@ def read_solution(problem: SchedulingProblem, model_path: str | Path, solution_p
     """The schedule of another solver's answer to the model :func:`write_model` wrote for ``problem``
     (module docstring). A file that names none of the flights' ``operate`` variables, an answer
     that breaks the model, or a mapping of other flights is one clear error."""
-    from uamopt.solvers.milp import build_model, chosen_gaps, least_cost_delays, least_delays, pad_orders
+    mapping = read_mapping(problem, model_path)
+    values = read_values(solution_path, set(mapping["variables"]))
+    operated, delay = decisions(problem, mapping, values, str(solution_path))
+    return make_schedule(problem, solver, "stopped", operated, delay,
+                         extras={"model": "continuous", "model_kind": "continuous",
+                                 "solution_file": str(solution_path), "model_file": str(model_path)})
 
+
+def read_mapping(problem: SchedulingProblem, model_path: str | Path) -> dict:
+    """The mapping file beside ``model_path``, checked to be of ``problem``'s flights."""
     side = columns_path(model_path)
     try:
         mapping = json.loads(side.read_text(encoding="utf-8"))
-        names, operate = dict(mapping["variables"]), dict(mapping["operate"])
+        dict(mapping["variables"]), dict(mapping["operate"]), dict(mapping["delay"])
     except (OSError, ValueError, KeyError, TypeError) as exc:
         raise InputFileError(f"cannot read the model's mapping: {exc}", str(side),
-                             "write the model again with write_model / uamopt export mps") from None
-    ids = [f.id for f in problem.flights.flights]
-    if list(mapping.get("flights", [])) != ids:
+                             "write the model again with write_model / uamopt flights --model mps") from None
+    if list(mapping.get("flights", [])) != [f.id for f in problem.flights.flights]:
         raise InputFileError("the mapping is of other flights than this problem's", str(side),
                              "read the solution with the problem the model was written from")
-    values = read_values(solution_path, set(names))
+    return mapping
+
+
+def decisions(problem: SchedulingProblem, mapping: dict, values: dict[str, float], where: str
+              ) -> tuple[np.ndarray, np.ndarray]:
+    """(operated, delays) of a solver's column values (keyed by the file's names): ``operate`` at 0.5,
+    the solver's own delays checked (:data:`ANSWER_TOL_S`), then the delays recomputed exactly from
+    its gap and pad-order choices (milp.py ``least_delays``); any break is one InputFileError."""
+    from uamopt.solvers.milp import build_model, chosen_gaps, least_cost_delays, least_delays, pad_orders
+
+    ids = [f.id for f in problem.flights.flights]
+    names, operate, delay_of = mapping["variables"], mapping["operate"], mapping["delay"]
     if not any(operate[fid] in values for fid in ids):
-        raise InputFileError("the solution names none of the flights' operate variables", str(solution_path),
-                             f"write it with the variable names of {Path(model_path).name} (e.g. {operate[ids[0]]})")
-    model = build_model(problem)
-    for symbol, value in values.items():
-        component = model.find_component(names[symbol])
-        if component is not None:
-            component.set_value(value, skip_validation=True)
-    n = problem.n_flights
+        raise InputFileError("the solution names none of the flights' operate variables", where,
+                             f"write it with the variable names of the model file (e.g. {operate[ids[0]]})")
     operated = np.array([values.get(operate[fid], 0.0) > 0.5 for fid in ids])
-    delay_of = dict(mapping["delay"])
     raw = np.array([values.get(delay_of[fid], 0.0) if delay_of.get(fid) else 0.0 for fid in ids])
     wrong = _breaks(problem, operated, np.where(operated, raw, 0.0))
     if wrong:
-        raise InputFileError(f"the solution breaks the model: {wrong}", str(solution_path),
+        raise InputFileError(f"the solution breaks the model: {wrong}", where,
                              "check that it is a feasible answer of this model (its delays as written)")
+    model = build_model(problem)
+    for symbol, value in values.items():
+        component = model.find_component(names[symbol]) if symbol in names else None
+        if component is not None:
+            component.set_value(value, skip_validation=True)
     chosen, orders = chosen_gaps(model, operated), pad_orders(model, operated)
     delay = (least_delays(problem, operated, chosen, orders) if not problem.objective.per_flight_terms
              else least_cost_delays(problem, operated, chosen, orders))
     if delay is None:
         raise InputFileError("the solution's choices admit no delays within the bounds (it breaks the model)",
-                             str(solution_path), "check that it is a feasible answer of this model")
+                             where, "check that it is a feasible answer of this model")
     delay = np.where(operated, delay, 0.0)
     bad = violations(problem, operated, delay)
     if bad:
-        raise InputFileError(f"the solution breaks the model: {bad[0]}", str(solution_path),
+        raise InputFileError(f"the solution breaks the model: {bad[0]}", where,
                              "check that it is a feasible answer of this model")
-    return make_schedule(problem, solver, "stopped", operated, delay[:n],
-                         extras={"model": "continuous", "model_kind": "continuous",
-                                 "solution_file": str(solution_path), "model_file": str(model_path)})
+    return operated, delay
