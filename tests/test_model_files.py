@@ -31,8 +31,7 @@ OBJ_TOL = 1e-6
 def outside_solve(model_file, solution_file) -> tuple[str, float]:
     """HiGHS reading the file alone; (its model status, its objective)."""
     h = highspy.Highs()
-    h.setOptionValue("output_flag", False)
-    h.setOptionValue("threads", 1)
+    h.setOptionValue("output_flag", False)  # threads left alone: HiGHS keeps one pool per process (test_infeasible.py)
     assert h.readModel(str(model_file)) in (highspy.HighsStatus.kOk, highspy.HighsStatus.kWarning)
     h.run()
     h.writeSolution(str(solution_file), 0)
