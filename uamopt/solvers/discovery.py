@@ -167,12 +167,13 @@ class Constraints:
         return cls(p=view.p[view.row_pair], q=view.q[view.row_pair], lo=view.lo - shift, hi=view.hi - shift,
                    te=t.e, tf=t.f, need=t.need_s)
 
-    def broken(self, operated: np.ndarray, delay_s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(pair rows, turnaround rows) a decision breaks, with the verifier's tolerance τ."""
+    def broken(self, operated: np.ndarray, delay_s: np.ndarray, tol_s: float = TIME_TOL_S
+               ) -> tuple[np.ndarray, np.ndarray]:
+        """(pair rows, turnaround rows) a decision breaks by more than ``tol_s`` (default the verifier's τ)."""
         z = delay_s[self.q] - delay_s[self.p]
-        pair = operated[self.p] & operated[self.q] & (self.lo + TIME_TOL_S < z) & (z < self.hi - TIME_TOL_S)
+        pair = operated[self.p] & operated[self.q] & (self.lo + tol_s < z) & (z < self.hi - tol_s)
         zt = delay_s[self.tf] - delay_s[self.te]
-        turn = operated[self.te] & operated[self.tf] & (zt < self.need - TIME_TOL_S)
+        turn = operated[self.te] & operated[self.tf] & (zt < self.need - tol_s)
         return np.flatnonzero(pair), np.flatnonzero(turn)
 
 

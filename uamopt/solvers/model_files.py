@@ -72,12 +72,13 @@ def write_model(problem: SchedulingProblem, path: str | Path) -> tuple[Path, Pat
         by_symbol = model.solutions.symbol_map[symbols].bySymbol
         names = {symbol: _component(obj).name for symbol, obj in by_symbol.items()
                  if _component(obj).is_variable_type()}  # the columns (the symbol map names the rows too)
+        symbol_of = {name: symbol for symbol, name in names.items()}
         ids = [f.id for f in problem.flights.flights]
         mapping = {"format": fmt, "model": "continuous MILP of Eqs. 20-31 (uamopt/solvers/milp.py build_model)",
                    "objective_kind": problem.objective_kind, "weights": list(problem.weights),
                    "aircraft": problem.aircraft_count, "flights": ids,
-                   "operate": {fid: _symbol(names, f"operate[{i}]") for i, fid in enumerate(ids)},
-                   "delay": {fid: _symbol(names, f"delay[{i}]") for i, fid in enumerate(ids)},
+                   "operate": {fid: symbol_of.get(f"operate[{i}]") for i, fid in enumerate(ids)},
+                   "delay": {fid: symbol_of.get(f"delay[{i}]") for i, fid in enumerate(ids)},
                    "variables": names}
         side = columns_path(path)
         side_tmp = side.with_name(side.name + ".part")
@@ -92,13 +93,6 @@ def write_model(problem: SchedulingProblem, path: str | Path) -> tuple[Path, Pat
 
 def _component(obj):
     return obj() if callable(obj) and not hasattr(obj, "name") else obj  # a weak reference in some Pyomo versions
-
-
-def _symbol(names: dict[str, str], component: str) -> str | None:
-    for symbol, name in names.items():
-        if name == component:
-            return symbol
-    return None
 
 
 def read_values(solution_path: str | Path, symbols: set[str]) -> dict[str, float]:
@@ -134,24 +128,24 @@ ANSWER_TOL_S = 1e-3  # a solver's own delays may break a row by this much (its f
 
 
 def _breaks(problem: SchedulingProblem, operated: np.ndarray, delay: np.ndarray) -> str | None:
-    """The first pair interval or turnaround the solver's own delays break by more than ``ANSWER_TOL_S``."""
+    """The first pair interval or turnaround the solver's own delays break by more than ``ANSWER_TOL_S``,
+    or a delay outside its bounds by as much, in words."""
     from uamopt.solvers.discovery import Constraints
 
     cons = Constraints.of(problem)
-    z = delay[cons.q] - delay[cons.p]
-    bad = np.flatnonzero(operated[cons.p] & operated[cons.q] & (cons.lo + ANSWER_TOL_S < z) & (z < cons.hi - ANSWER_TOL_S))
+    pair, turn = cons.broken(operated, delay, ANSWER_TOL_S)
     ids = [f.id for f in problem.flights.flights]
-    if len(bad):
-        k = int(bad[0])
-        return (f"{ids[cons.p[k]]} and {ids[cons.q[k]]} depart {z[k]:.6g} s apart, inside their forbidden "
-                f"({cons.lo[k]:.6g}, {cons.hi[k]:.6g})")
-    zt = delay[cons.tf] - delay[cons.te]
-    late = np.flatnonzero(operated[cons.te] & operated[cons.tf] & (zt < cons.need - ANSWER_TOL_S))
-    if len(late):
-        k = int(late[0])
-        return f"{ids[cons.tf[k]]} leaves {cons.need[k] - zt[k]:.6g} s before its aircraft's turnaround ends"
-    if np.any(operated & ((delay < -ANSWER_TOL_S) | (delay > problem.delay_upper_s + ANSWER_TOL_S))):
-        f = int(np.flatnonzero(operated & ((delay < -ANSWER_TOL_S) | (delay > problem.delay_upper_s + ANSWER_TOL_S)))[0])
+    if len(pair):
+        k = int(pair[0])
+        return (f"{ids[cons.p[k]]} and {ids[cons.q[k]]} depart {delay[cons.q[k]] - delay[cons.p[k]]:.6g} s apart, "
+                f"inside their forbidden ({cons.lo[k]:.6g}, {cons.hi[k]:.6g})")
+    if len(turn):
+        k = int(turn[0])
+        short = cons.need[k] - (delay[cons.tf[k]] - delay[cons.te[k]])
+        return f"{ids[cons.tf[k]]} leaves {short:.6g} s before its aircraft's turnaround ends"
+    outside = np.flatnonzero(operated & ((delay < -ANSWER_TOL_S) | (delay > problem.delay_upper_s + ANSWER_TOL_S)))
+    if len(outside):
+        f = int(outside[0])
         return f"{ids[f]}'s delay {delay[f]:.6g} s is outside [0, {problem.delay_upper_s[f]:.6g}]"
     return None
 

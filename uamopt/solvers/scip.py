@@ -31,8 +31,6 @@ from uamopt.schedule.model import Schedule, SchedulingProblem, Termination, clos
 from uamopt.solvers.milp import OBJECTIVES, SHAPES  # noqa: F401 (the same model: the same shapes and objectives)
 from uamopt.solvers.watchdog import report_bound, report_incumbent
 
-BUILD_SHARE = 0.5  # at most this share of the limit for writing the model file before SCIP starts
-
 
 def solve(problem: SchedulingProblem, profile) -> Schedule:
     """Write the MILP, solve it with SCIP within the profile's limit, read its answer back."""
